@@ -1,0 +1,154 @@
+// Images (paper §2.1.1, §3.1): a dense scalar volume with its physical geometry, and the
+// binary images the engine works on — a threshold (f > s), a label selection (f = L), or an
+// implicit predicate with no storage at all. Every binary image answers `(x, y, z)` for any
+// voxel of Z^3: voxels outside the domain take the value `outside` (0 unless asked otherwise).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "Voxel.h"
+
+namespace surftrack {
+
+/// Size of a domain [0, nx) x [0, ny) x [0, nz).
+struct Dims {
+  int nx = 0, ny = 0, nz = 0;
+  constexpr int operator[](int axis) const { return axis == 0 ? nx : axis == 1 ? ny : nz; }
+  constexpr bool contains(int x, int y, int z) const {
+    return unsigned(x) < unsigned(nx) && unsigned(y) < unsigned(ny) && unsigned(z) < unsigned(nz);
+  }
+  constexpr bool contains(Voxel v) const { return contains(v.x, v.y, v.z); }
+  constexpr std::size_t count() const { return std::size_t(nx) * std::size_t(ny) * std::size_t(nz); }
+  constexpr bool empty() const { return nx <= 0 || ny <= 0 || nz <= 0; }
+  friend constexpr bool operator==(const Dims&, const Dims&) = default;
+};
+
+/// Physical placement of voxel indices: x_phys = origin + direction * (spacing ⊙ index).
+struct ImageGeometry {
+  std::array<double, 3> spacing{1.0, 1.0, 1.0};
+  std::array<double, 3> origin{0.0, 0.0, 0.0};
+  std::array<std::array<double, 3>, 3> direction{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+
+  /// Maps a (continuous) index-space point to physical space.
+  std::array<double, 3> toPhysical(const std::array<double, 3>& index) const {
+    std::array<double, 3> p = origin;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) p[r] += direction[r][c] * spacing[c] * index[c];
+    return p;
+  }
+};
+
+/// A dense volume of scalars (uint8, int16, uint16, int32, float, double, ...), x fastest.
+template <class T>
+class DenseImage {
+ public:
+  using value_type = T;
+
+  DenseImage() = default;
+  explicit DenseImage(Dims dims, T fill = T{}, ImageGeometry geometry = {})
+      : dims_(dims), geometry_(geometry) {
+    if (dims.empty()) throw std::invalid_argument("image dimensions must be positive");
+    data_.assign(dims.count(), fill);
+  }
+
+  const Dims& dims() const { return dims_; }
+  const ImageGeometry& geometry() const { return geometry_; }
+  ImageGeometry& geometry() { return geometry_; }
+
+  std::size_t index(int x, int y, int z) const {
+    return (std::size_t(z) * std::size_t(dims_.ny) + std::size_t(y)) * std::size_t(dims_.nx) +
+           std::size_t(x);
+  }
+  T& at(int x, int y, int z) { return data_[index(x, y, z)]; }
+  const T& at(int x, int y, int z) const { return data_[index(x, y, z)]; }
+  T& at(Voxel v) { return at(v.x, v.y, v.z); }
+  const T& at(Voxel v) const { return at(v.x, v.y, v.z); }
+
+  std::vector<T>& data() { return data_; }
+  const std::vector<T>& data() const { return data_; }
+
+ private:
+  Dims dims_;
+  ImageGeometry geometry_;
+  std::vector<T> data_;
+};
+
+/// Binary image of a gray image J at iso-value s (§3.1): f(v) > s is a 1-voxel.
+template <class T>
+class ThresholdImage {
+ public:
+  ThresholdImage(const DenseImage<T>& image, double isoValue, bool outside = false)
+      : image_(&image), iso_(isoValue), outside_(outside) {
+    if (std::isnan(isoValue)) throw std::invalid_argument("iso-value is NaN");
+  }
+  bool operator()(int x, int y, int z) const {
+    if (!image_->dims().contains(x, y, z)) return outside_;
+    return double(image_->at(x, y, z)) > iso_;
+  }
+  bool operator()(Voxel v) const { return (*this)(v.x, v.y, v.z); }
+  const Dims& dims() const { return image_->dims(); }
+  const DenseImage<T>& gray() const { return *image_; }
+  double isoValue() const { return iso_; }
+
+ private:
+  const DenseImage<T>* image_;
+  double iso_;
+  bool outside_;
+};
+
+/// Binary image of a label image: f(v) = L is a 1-voxel.
+template <class T>
+class LabelImage {
+ public:
+  LabelImage(const DenseImage<T>& image, T label, bool outside = false)
+      : image_(&image), label_(label), outside_(outside) {}
+  bool operator()(int x, int y, int z) const {
+    if (!image_->dims().contains(x, y, z)) return outside_;
+    return image_->at(x, y, z) == label_;
+  }
+  bool operator()(Voxel v) const { return (*this)(v.x, v.y, v.z); }
+  const Dims& dims() const { return image_->dims(); }
+
+ private:
+  const DenseImage<T>* image_;
+  T label_;
+  bool outside_;
+};
+
+/// A binary image given by a predicate `bool(int x, int y, int z)` on a domain, with no storage:
+/// it can describe volumes far too large to hold or scan (a 4096^3 ball, say).
+template <class Predicate>
+class ImplicitImage {
+ public:
+  ImplicitImage(Dims dims, Predicate predicate, bool outside = false)
+      : dims_(dims), predicate_(std::move(predicate)), outside_(outside) {
+    if (dims.empty()) throw std::invalid_argument("image dimensions must be positive");
+  }
+  bool operator()(int x, int y, int z) const {
+    if (!dims_.contains(x, y, z)) return outside_;
+    return predicate_(x, y, z);
+  }
+  bool operator()(Voxel v) const { return (*this)(v.x, v.y, v.z); }
+  const Dims& dims() const { return dims_; }
+
+ private:
+  Dims dims_;
+  Predicate predicate_;
+  bool outside_;
+};
+
+/// A stored binary volume (one byte per voxel); handy for tests and small images.
+using BinaryVolume = DenseImage<std::uint8_t>;
+
+/// The binary image of a 0/1 volume (1 is a 1-voxel).
+inline ThresholdImage<std::uint8_t> binaryView(const BinaryVolume& volume, bool outside = false) {
+  return ThresholdImage<std::uint8_t>(volume, 0.5, outside);
+}
+
+}  // namespace surftrack

@@ -1,0 +1,118 @@
+// Definition 38: degrees and symmetry of the beta-adjacency, and the strict 26-configurations
+// (rule (iv)) of 1-voxels and of 0-voxels.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <random>
+
+#include "DigitalCube.h"
+#include "ScanBoundaries.h"
+#include "TrackComponent.h"
+#include "VoxelComponents.h"
+
+using namespace surftrack;
+using namespace surftrack::testing;
+
+namespace {
+
+// Counted from the cube configuration alone, independently of betaNeighbours.
+template <class Image>
+int strict26Cubes(const Image& image, const Surfel& s, AdjacencyPair pair) {
+  int count = 0;
+  for (Voxel m : cube::cubesOf(s)) {
+    const std::uint8_t config = cube::configurationAt(image, m);
+    const std::uint8_t ones = kappa(pair) == 26 ? config : std::uint8_t(~config);
+    if (kappa(pair) != 26 && lambda(pair) != 26) continue;
+    if (std::popcount(ones) != 2) continue;
+    int i = std::countr_zero(ones), j = 7 - std::countl_zero(ones);
+    if ((i ^ j) == 7) ++count;
+  }
+  return count;
+}
+
+class BetaAdjacency : public ::testing::TestWithParam<AdjacencyPair> {};
+
+TEST_P(BetaAdjacency, DegreesAndSymmetryOnRandomImages) {
+  const AdjacencyPair pair = GetParam();
+  std::mt19937 rng(7);
+  for (int i = 0; i < 300; ++i) {
+    const BinaryVolume volume =
+        randomVolume({8, 7, 6}, std::uniform_real_distribution<double>(0.1, 0.9)(rng), rng());
+    const auto image = binaryView(volume);
+    for (const Surfel& s : allBoundarySurfels(image)) {
+      Surfel nb[kMaxBetaNeighbours];
+      const int k = betaNeighbours(image, s, pair, nb);
+      ASSERT_EQ(k, 4 + 2 * strict26Cubes(image, s, pair)) << s;
+      for (int j = 0; j < k; ++j) {
+        ASSERT_TRUE(isBoundarySurfel(image, nb[j])) << s << " -> " << nb[j];
+        ASSERT_EQ(std::count(nb, nb + k, nb[j]), 1) << "repeated neighbour of " << s;
+        Surfel back[kMaxBetaNeighbours];
+        const int kb = betaNeighbours(image, nb[j], pair, back);
+        ASSERT_EQ(std::count(back, back + kb, s), 1) << "asymmetric arc " << s << " " << nb[j];
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllPairs, BetaAdjacency, ::testing::ValuesIn(kAllAdjacencyPairs),
+                         [](const auto& info) { return "k" + std::to_string(kappa(info.param)) +
+                                                       "_" + std::to_string(lambda(info.param)); });
+
+std::size_t componentCount(const BinaryVolume& volume, AdjacencyPair pair) {
+  return scanBoundaries(binaryView(volume), pair).componentCount;
+}
+
+TEST(Strict26, TwoDiagonalOneVoxelsAreOneBoundaryOnlyFor26) {
+  BinaryVolume volume({2, 2, 2});
+  volume.at(0, 0, 0) = volume.at(1, 1, 1) = 1;
+  const auto image = binaryView(volume);
+  const SurfaceGraph g = trackComponent(image, Surfel{{0, 0, 0}, 0}, AdjacencyPair::k26_6);
+  EXPECT_EQ(g.surfelCount(), 12u);
+  // The three surfels of each voxel inside the cube gain two vertex links each.
+  EXPECT_EQ(g.arcCount(), (12 * 4 + 6 * 2) / 2);
+  EXPECT_EQ(componentCount(volume, AdjacencyPair::k26_6), 1u);
+  EXPECT_EQ(componentCount(volume, AdjacencyPair::k18_6), 2u);
+  EXPECT_EQ(componentCount(volume, AdjacencyPair::k6_18), 2u);
+  EXPECT_EQ(componentCount(volume, AdjacencyPair::k6_26), 2u);
+}
+
+TEST(Strict26, TwoDiagonalZeroVoxelsAreOneBoundaryOnlyFor26) {
+  BinaryVolume volume({4, 4, 4}, 1);
+  volume.at(1, 1, 1) = volume.at(2, 2, 2) = 0;
+  const auto image = binaryView(volume);
+  const SurfaceGraph g = trackComponent(image, Surfel{{0, 1, 1}, 0}, AdjacencyPair::k6_26);
+  EXPECT_EQ(g.surfelCount(), 12u);
+  EXPECT_EQ(g.arcCount(), (12 * 4 + 6 * 2) / 2);
+  EXPECT_EQ(componentCount(volume, AdjacencyPair::k6_26), 2u);  // the two holes + the outside
+  EXPECT_EQ(componentCount(volume, AdjacencyPair::k6_18), 3u);
+  EXPECT_EQ(componentCount(volume, AdjacencyPair::k26_6), 3u);
+  EXPECT_EQ(componentCount(volume, AdjacencyPair::k18_6), 3u);
+}
+
+TEST(Strict26, NonStrictDiagonalGetsNoVertexLinks) {
+  // A third 1-voxel in the cube makes the diagonal 18-connected: no rule (iv) arcs.
+  BinaryVolume volume({2, 2, 2});
+  volume.at(0, 0, 0) = volume.at(1, 1, 1) = volume.at(1, 0, 0) = 1;
+  const auto image = binaryView(volume);
+  for (const Surfel& s : allBoundarySurfels(image)) {
+    Surfel nb[kMaxBetaNeighbours];
+    EXPECT_EQ(betaNeighbours(image, s, AdjacencyPair::k26_6, nb), 4) << s;
+  }
+}
+
+TEST(EdgeRule, Kappa6TurnsInwardWhereKappa18TurnsOutward) {
+  // Two 1-voxels sharing only an edge: a = I(u+e) = 0, b = I(u+n+e) = 1 for the surfel between
+  // them (spec §2, last row of the table).
+  BinaryVolume volume({2, 2, 1});
+  volume.at(0, 0, 0) = volume.at(1, 1, 0) = 1;
+  const auto image = binaryView(volume);
+  const Surfel t{{0, 0, 0}, 2};  // normal +y, towards (0,1,0)
+  Surfel nb[kMaxBetaNeighbours];
+  betaNeighbours(image, t, AdjacencyPair::k18_6, nb);
+  EXPECT_EQ(nb[0], (Surfel{{1, 1, 0}, 1}));  // (ii): same 0-voxel (0,1,0), turns outward
+  betaNeighbours(image, t, AdjacencyPair::k6_18, nb);
+  EXPECT_EQ(nb[0], (Surfel{{0, 0, 0}, 0}));  // (i): same 1-voxel, turns inward
+}
+
+}  // namespace

@@ -1,0 +1,121 @@
+// trackComponent on images that cannot be scanned, its errors, and the seed finder.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "FindSeed.h"
+#include "TrackComponent.h"
+#include "VoxelComponents.h"
+
+using namespace surftrack;
+using namespace surftrack::testing;
+
+namespace {
+
+// Number of grid lines parallel to `axis` that meet the digital ball |v - c|^2 <= r2 (c integer):
+// a line at squared distance d2 from c meets it iff d2 <= r2. O(q^2), independent of surfels.
+std::int64_t linesMeetingBall(std::int64_t r2, int radius) {
+  std::int64_t lines = 0;
+  for (int a = -radius; a <= radius; ++a)
+    for (int b = -radius; b <= radius; ++b) lines += std::int64_t(a) * a + std::int64_t(b) * b <= r2;
+  return lines;
+}
+
+TEST(Tracking, ImplicitBallOfRadius900InA4096CubedDomain) {
+  // 68 G voxels: this image can be neither stored nor scanned; tracking touches its surface only.
+  const int c = 2048, radius = 900;
+  const std::int64_t r2 = std::int64_t(radius) * radius;
+  const ImplicitImage ball({4096, 4096, 4096}, [&](int x, int y, int z) {
+    const std::int64_t dx = x - c, dy = y - c, dz = z - c;
+    return dx * dx + dy * dy + dz * dz <= r2;
+  });
+  const auto seed = seedAlongRay(ball, Voxel{c, c, c}, 0);
+  ASSERT_TRUE(seed.has_value());
+  EXPECT_EQ(*seed, (Surfel{{c + radius, c, c}, 0}));
+  const SurfaceGraph g = trackComponent(ball, *seed, AdjacencyPair::k26_6);
+  // Each line meets the ball in one interval, hence carries exactly 2 surfels along it; by
+  // symmetry L_x = L_y = L_z.
+  EXPECT_EQ(std::int64_t(g.surfelCount()), 2 * 3 * linesMeetingBall(r2, radius));
+}
+
+TEST(Tracking, BallFromAnySeedInEveryPair) {
+  const ImplicitImage ball({40, 40, 40}, [](int x, int y, int z) {
+    return (x - 20) * (x - 20) + (y - 19) * (y - 19) + (z - 21) * (z - 21) <= 150;
+  });
+  for (AdjacencyPair pair : kAllAdjacencyPairs) {
+    const SurfaceGraph g = trackComponent(ball, *seedAlongRay(ball, Voxel{20, 19, 21}, 3), pair);
+    EXPECT_EQ(std::int64_t(g.surfelCount()), 2 * 3 * linesMeetingBall(150, 13));
+    const SurfaceGraph h = trackComponent(ball, g.surfels.back(), pair);
+    EXPECT_EQ(sortedKeys(h.surfels), sortedKeys(g.surfels));
+  }
+}
+
+TEST(Tracking, SeedThatIsNotABoundarySurfelIsRejectedWithTheVoxelNamed) {
+  BinaryVolume volume({4, 4, 4});
+  volume.at(1, 1, 1) = 1;
+  const auto image = binaryView(volume);
+  try {
+    trackComponent(image, Surfel{{2, 1, 1}, 0}, AdjacencyPair::k18_6);
+    FAIL() << "expected an exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("c=(2,1,1) is a 0-voxel"), std::string::npos) << e.what();
+  }
+  try {
+    trackComponent(image, Surfel{{0, 1, 1}, 0}, AdjacencyPair::k18_6);
+    FAIL() << "expected an exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("d=(1,1,1) is a 1-voxel"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Tracking, SeedOutsideTheDomainIsRejected) {
+  BinaryVolume volume({4, 4, 4}, 1);
+  const auto image = binaryView(volume);
+  EXPECT_THROW(trackComponent(image, Surfel{{9, 0, 0}, 0}, AdjacencyPair::k26_6),
+               std::invalid_argument);
+  // The outer surfels of the domain border are fine: the outside is background.
+  EXPECT_EQ(trackComponent(image, Surfel{{3, 0, 0}, 0}, AdjacencyPair::k26_6).surfelCount(),
+            6u * 16u);
+}
+
+TEST(Tracking, EmptyImageHasNoSeedAndNoBoundary) {
+  BinaryVolume volume({5, 5, 5});
+  const auto image = binaryView(volume);
+  EXPECT_FALSE(seedAlongRay(image, Voxel{2, 2, 2}, 0).has_value());
+  EXPECT_THROW(trackComponent(image, Surfel{{2, 2, 2}, 0}, AdjacencyPair::k26_6),
+               std::invalid_argument);
+  EXPECT_THROW(DenseImage<float>(Dims{0, 3, 3}), std::invalid_argument);
+}
+
+TEST(Tracking, UnsupportedPairIsRejected) {
+  EXPECT_THROW(parseAdjacencyPair("18-18"), std::invalid_argument);
+  EXPECT_THROW(parseAdjacencyPair("26-26"), std::invalid_argument);
+  EXPECT_EQ(parseAdjacencyPair("6,26"), AdjacencyPair::k6_26);
+}
+
+TEST(SeedAlongRay, FromInsideAndFromOutside) {
+  BinaryVolume volume({8, 3, 3});
+  for (int x = 3; x <= 5; ++x) volume.at(x, 1, 1) = 1;
+  const auto image = binaryView(volume);
+  EXPECT_EQ(*seedAlongRay(image, Voxel{4, 1, 1}, 0), (Surfel{{5, 1, 1}, 0}));
+  EXPECT_EQ(*seedAlongRay(image, Voxel{0, 1, 1}, 0), (Surfel{{3, 1, 1}, 1}));
+  EXPECT_EQ(*seedAlongRay(image, Voxel{4, 1, 1}, 1), (Surfel{{3, 1, 1}, 1}));
+}
+
+TEST(SurfaceGraph, ArcsAreSymmetricAndMatchTheNeighbours) {
+  const BinaryVolume volume = randomVolume({10, 10, 10}, 0.5, 99);
+  const auto image = binaryView(volume);
+  const auto seed = seedAlongRay(image, Voxel{0, 0, 0}, 0);
+  ASSERT_TRUE(seed);
+  const SurfaceGraph g = trackComponent(image, *seed, AdjacencyPair::k26_6);
+  for (std::uint32_t v = 0; v < g.surfelCount(); ++v) {
+    Surfel nb[kMaxBetaNeighbours];
+    const int k = betaNeighbours(image, g.surfels[v], g.pair, nb);
+    ASSERT_EQ(int(boost::out_degree(v, g.graph)), k);
+    int j = 0;
+    for (auto w : boost::make_iterator_range(boost::adjacent_vertices(v, g.graph)))
+      ASSERT_EQ(g.surfels[w], nb[j++]);
+  }
+}
+
+}  // namespace
