@@ -116,3 +116,40 @@ TEST(EdgeRule, Kappa6TurnsInwardWhereKappa18TurnsOutward) {
 }
 
 }  // namespace
+
+#include "BetaNeighbourTable.h"
+
+namespace {
+
+TEST(BetaNeighbourTable, AgreesWithDefinition38OnEveryNeighbourhood) {
+  // The tracker's table must give the reference neighbours, in the same order, for every
+  // pattern of the 16 voxels Definition 38 looks at around a surfel (u = 1, u + n = 0).
+  for (AdjacencyPair pair : kAllAdjacencyPairs) {
+    const BetaNeighbourTable table(pair);
+    for (Direction n = 0; n < 6; ++n) {
+      const Voxel u{0, 0, 0}, un = unitVector(n);
+      std::vector<int> relevant;
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Voxel d{dx, dy, dz};
+            // The 3x3x2 slab spanned by u and u + n, less those two.
+            const bool inSlab = d[axisOf(n)] == 0 || d[axisOf(n)] == signOf(n);
+            if (inSlab && d != u && d != un) relevant.push_back(Neighbourhood::bitOf(d));
+          }
+      ASSERT_EQ(relevant.size(), 16u);
+      const Surfel t{Voxel{5, -3, 7}, n};
+      for (std::uint32_t pattern = 0; pattern < (1u << 16); ++pattern) {
+        std::uint32_t bits = 1u << Neighbourhood::bitOf(u);
+        for (int i = 0; i < 16; ++i)
+          if ((pattern >> i) & 1) bits |= 1u << relevant[i];
+        Surfel expected[kMaxBetaNeighbours], found[kMaxBetaNeighbours];
+        const int k = betaNeighbours(Neighbourhood{t.c, bits}, t, pair, expected);
+        ASSERT_EQ(table.neighbours(bits, t, found), k) << toString(pair) << " pattern " << pattern;
+        for (int j = 0; j < k; ++j) ASSERT_EQ(found[j], expected[j]) << toString(pair);
+      }
+    }
+  }
+}
+
+}  // namespace

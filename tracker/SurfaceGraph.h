@@ -30,7 +30,7 @@ struct SurfaceGraph {
 
 /// Builds the Boost CSR graph from per-vertex neighbour lists given in vertex order
 /// (rowStart has one entry per vertex plus one; targets[rowStart[v]..rowStart[v+1]) are v's).
-SurfelGraph makeSurfelGraph(const std::vector<std::uint32_t>& rowStart,
-                            const std::vector<std::uint32_t>& targets);
+SurfelGraph makeSurfelGraph(std::vector<std::uint32_t>&& rowStart,
+                            std::vector<std::uint32_t>&& targets);
 
 }  // namespace surftrack

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "Hash.h"
 #include "Surfel.h"
 
 namespace surftrack {
@@ -54,9 +55,14 @@ class SurfelIndexMap {
     while (c < 2 * n) c *= 2;
     return c;
   }
+  // Surfels of one 4x4x4 block of voxels share a 512-slot window of the table, so that the
+  // traversal, which moves across the surface locally, keeps hitting the same cache lines.
   std::size_t slot(std::uint64_t key) const {
-    key *= 0x9E3779B97F4A7C15ull;
-    return std::size_t(key >> 32 ^ key) & mask_;
+    constexpr std::uint64_t kLocal = 0x7ull | (0x3ull << 3) | (0x3ull << 23) | (0x3ull << 43);
+    const std::uint64_t local = (key & 7u) | ((key >> 3) & 3u) << 3 | ((key >> 23) & 3u) << 5 |
+                                ((key >> 43) & 3u) << 7;
+    const std::uint64_t block = mix64(key & ~kLocal);
+    return std::size_t((block << 9) | local) & mask_;
   }
   void rehash(std::size_t capacity) {
     std::vector<Slot> old = std::move(slots_);

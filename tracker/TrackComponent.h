@@ -9,10 +9,14 @@
 #include <functional>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "AdjacencyPair.h"
 #include "BetaAdjacency.h"
+#include "BetaNeighbourTable.h"
+#include "BinaryBrickCache.h"
+#include "Image.h"
 #include "SurfaceGraph.h"
 #include "SurfelIndexMap.h"
 
@@ -54,11 +58,14 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
   SurfelIndexMap index;
   surfels.push_back(seed);
   index.insert(seed, 0);
+  BinaryBrickCache<BinaryImage> cache(image);
+  const BetaNeighbourTable beta(pair);
   Surfel neighbours[kMaxBetaNeighbours];
   // The queue is `surfels` itself: vertex v is expanded at step v, so the arcs come out
   // grouped by source, ready for the CSR graph.
   for (std::size_t v = 0; v < surfels.size(); ++v) {
-    const int count = betaNeighbours(image, surfels[v], pair, neighbours);
+    const Surfel t = surfels[v];
+    const int count = beta.neighbours(cache.neighbourhood(t.inside()).bits, t, neighbours);
     for (int k = 0; k < count; ++k) {
       auto [w, isNew] = index.insert(neighbours[k], std::uint32_t(surfels.size()));
       if (isNew) surfels.push_back(neighbours[k]);
@@ -67,7 +74,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
     rowStart.push_back(std::uint32_t(targets.size()));
     if (progress && (v & 0xFFFFF) == 0xFFFFF) progress(surfels.size());
   }
-  result.graph = makeSurfelGraph(rowStart, targets);
+  result.graph = makeSurfelGraph(std::move(rowStart), std::move(targets));
   return result;
 }
 

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs what surftrack needs on Debian 12 (run as root; uses sudo otherwise).
+# Only missing packages are installed, so a second run costs a second.
+set -euo pipefail
+
+packages=(
+  build-essential cmake          # compiler and build system
+  libboost-graph-dev             # Boost.Graph: the surface graph, voxel components in tests
+  libopenmesh-dev                # OpenMesh: half-edge meshes and mesh IO
+  libgtest-dev                   # GoogleTest
+  libinsighttoolkit5-dev         # ITK: NIfTI / NRRD / MetaImage / DICOM volumes for the CLI
+  gnuplot-nox                    # plots of the Figure 9 benchmark
+  mricron-data                   # real MRI volumes used by the demo and one test
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}" >&2
+  sudo=""
+  [[ $(id -u) -eq 0 ]] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
