@@ -32,14 +32,46 @@ class BinaryBrickCache {
   explicit BinaryBrickCache(const BinaryImage& image) : image_(&image) { rehash(1024); }
 
   /// The 3x3x3 neighbourhood of voxel u.
-  Neighbourhood neighbourhood(Voxel u) {
-    const Brick& b = brick(u.x >> 3, u.y >> 3, u.z >> 3);
+  Neighbourhood neighbourhood(Voxel u) { return neighbourhood(brickOf(u), u); }
+
+  /// The same, when u's brick index is already known.
+  Neighbourhood neighbourhood(std::uint32_t brick, Voxel u) const {
+    const Brick& b = bricks_[brick];
     const int lx = u.x & 7, ly = u.y & 7, lz = u.z & 7;  // apron coordinates of u - (1,1,1)
     std::uint32_t bits = 0;
     int shift = 0;
     for (int z = lz; z <= lz + 2; ++z)
       for (int y = ly; y <= ly + 2; ++y, shift += 3) bits |= ((b.rows[z][y] >> lx) & 7u) << shift;
     return Neighbourhood{u, bits};
+  }
+
+  /// The index of the brick that contains voxel v.
+  std::uint32_t brickOf(Voxel v) { return brickIndex(v.x >> 3, v.y >> 3, v.z >> 3); }
+
+  /// The index (in creation order) of the brick of voxels 8 (bx, by, bz) + [0, 8)^3, created
+  /// and binarised on first use.
+  std::uint32_t brickIndex(int bx, int by, int bz) {
+    const std::uint64_t key = brickKey(bx, by, bz);
+    // A direct-mapped memo of recent bricks: the 4x4x4 bricks around the traversal front.
+    Recent& recent = recent_[(bx & 3) | (by & 3) << 2 | (bz & 3) << 4];
+    if (recent.key == key) return recent.brick;
+    std::size_t i = mix64(key) & mask_;
+    for (; slots_[i].key != kEmpty; i = (i + 1) & mask_)
+      if (slots_[i].key == key) return remember(recent, key, slots_[i].brick);
+    if (2 * (bricks_.size() + 1) > slots_.size()) {
+      rehash(2 * slots_.size());
+      return brickIndex(bx, by, bz);
+    }
+    slots_[i] = {key, std::uint32_t(bricks_.size())};
+    bricks_.push_back(binarise(key, bx, by, bz));
+    return remember(recent, key, std::uint32_t(bricks_.size() - 1));
+  }
+
+  /// The voxel 8 (bx, by, bz) of brick b.
+  Voxel brickOrigin(std::uint32_t b) const {
+    const std::uint64_t key = bricks_[b].key;
+    auto g = [](std::uint64_t v) { return 8 * (int(v & 0x1FFFFFu) - (1 << 20)); };
+    return Voxel{g(key), g(key >> 21), g(key >> 42)};
   }
 
   std::size_t brickCount() const { return bricks_.size(); }
@@ -58,31 +90,19 @@ class BinaryBrickCache {
     std::uint32_t brick;
   };
   static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
+  struct Recent {
+    std::uint64_t key = kEmpty;
+    std::uint32_t brick = 0;
+  };
 
   static std::uint64_t brickKey(int bx, int by, int bz) {
     auto f = [](int v) { return std::uint64_t(v + (1 << 20)) & 0x1FFFFFu; };
     return (f(bz) << 42) | (f(by) << 21) | f(bx);
   }
 
-  const Brick& brick(int bx, int by, int bz) {
-    const std::uint64_t key = brickKey(bx, by, bz);
-    if (key == lastKey_) return bricks_[lastBrick_];
-    std::size_t i = mix64(key) & mask_;
-    for (; slots_[i].key != kEmpty; i = (i + 1) & mask_)
-      if (slots_[i].key == key) return remember(key, slots_[i].brick);
-    if (2 * (bricks_.size() + 1) > slots_.size()) {
-      rehash(2 * slots_.size());
-      return brick(bx, by, bz);
-    }
-    slots_[i] = {key, std::uint32_t(bricks_.size())};
-    bricks_.push_back(binarise(key, bx, by, bz));
-    return remember(key, std::uint32_t(bricks_.size() - 1));
-  }
-
-  const Brick& remember(std::uint64_t key, std::uint32_t b) {
-    lastKey_ = key;
-    lastBrick_ = b;
-    return bricks_[b];
+  static std::uint32_t remember(Recent& recent, std::uint64_t key, std::uint32_t b) {
+    recent = {key, b};
+    return b;
   }
 
   Brick binarise(std::uint64_t key, int bx, int by, int bz) const {
@@ -115,8 +135,7 @@ class BinaryBrickCache {
   std::vector<Brick> bricks_;
   std::vector<Slot> slots_;
   std::size_t mask_ = 0;
-  std::uint64_t lastKey_ = kEmpty;
-  std::uint32_t lastBrick_ = 0;
+  std::array<Recent, 64> recent_;
 };
 
 }  // namespace surftrack

@@ -18,7 +18,7 @@
 #include "BinaryBrickCache.h"
 #include "Image.h"
 #include "SurfaceGraph.h"
-#include "SurfelIndexMap.h"
+#include "BrickSurfelSet.h"
 
 namespace surftrack {
 
@@ -45,34 +45,73 @@ void requireTrackableSeed(const BinaryImage& image, const Surfel& seed) {
 }
 
 /// The surface graph G(Sigma, beta) of the kappa-lambda-boundary Sigma containing `seed`.
-/// Vertex 0 is the seed; vertices are numbered in breadth-first order.
+/// Vertices are numbered by position (brick by brick), not in traversal order.
 template <class BinaryImage>
 SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, AdjacencyPair pair,
                             const TrackingProgress& progress = {}) {
   requireTrackableSeed(image, seed);
-  SurfaceGraph result;
-  result.pair = pair;
-  std::vector<Surfel>& surfels = result.surfels;
-  std::vector<std::uint32_t> rowStart{0};
-  std::vector<std::uint32_t> targets;
-  SurfelIndexMap index;
-  surfels.push_back(seed);
-  index.insert(seed, 0);
   BinaryBrickCache<BinaryImage> cache(image);
   const BetaNeighbourTable beta(pair);
+  BrickSurfelSet visited;
+  struct Place {
+    std::uint32_t brick;
+    int bit;
+  };
+  // Where surfel s is marked; `near` is a voxel whose brick `nearBrick` is known (a
+  // neighbour's 1-voxel is within ±1 of the current one, most often in the same brick).
+  auto placeOf = [&cache](const Surfel& s, Voxel near, std::uint32_t nearBrick) {
+    const Voxel c = s.inside();
+    const bool sameBrick = (((c.x ^ near.x) | (c.y ^ near.y) | (c.z ^ near.z)) >> 3) == 0;
+    return Place{sameBrick ? nearBrick : cache.brickOf(c),
+                 BrickSurfelSet::bitOf(Voxel{c.x & 7, c.y & 7, c.z & 7}, s.n)};
+  };
   Surfel neighbours[kMaxBetaNeighbours];
-  // The queue is `surfels` itself: vertex v is expanded at step v, so the arcs come out
-  // grouped by source, ready for the CSR graph.
-  for (std::size_t v = 0; v < surfels.size(); ++v) {
-    const Surfel t = surfels[v];
-    const int count = beta.neighbours(cache.neighbourhood(t.inside()).bits, t, neighbours);
+
+  // 1. Breadth-first traversal of beta-arcs from the seed: marks the surfels of Sigma.
+  {
+    std::vector<Surfel> queue{seed};
+    const Place p = placeOf(seed, seed.inside(), cache.brickOf(seed.inside()));
+    visited.insert(p.brick, p.bit);
+    for (std::size_t i = 0; i < queue.size(); ++i) {
+      const Surfel t = queue[i];
+      const std::uint32_t brick = cache.brickOf(t.inside());
+      const int count = beta.neighbours(cache.neighbourhood(brick, t.inside()).bits, t, neighbours);
+      for (int k = 0; k < count; ++k) {
+        const Place q = placeOf(neighbours[k], t.inside(), brick);
+        if (visited.insert(q.brick, q.bit)) queue.push_back(neighbours[k]);
+      }
+      if (progress && (i & 0xFFFFF) == 0xFFFFF) progress(queue.size());
+    }
+  }
+
+  // 2. Number the surfels brick by brick, so that each arc finds its target's index in O(1).
+  SurfaceGraph result;
+  result.pair = pair;
+  result.surfels.resize(visited.number());
+  {
+    std::size_t v = 0;
+    visited.forEach([&](std::uint32_t brick, int bit) {
+      const Voxel o = cache.brickOrigin(brick);
+      const int voxel = bit & 511;
+      result.surfels[v++] = Surfel{o + Voxel{voxel & 7, (voxel >> 3) & 7, voxel >> 6},
+                                   Direction(bit >> 9)};
+    });
+  }
+
+  // 3. The arcs, in compressed sparse row form.
+  std::vector<std::uint32_t> rowStart;
+  std::vector<std::uint32_t> targets;
+  rowStart.reserve(result.surfels.size() + 1);
+  targets.reserve(4 * result.surfels.size() + 64);
+  rowStart.push_back(0);
+  for (const Surfel& t : result.surfels) {
+    const std::uint32_t brick = cache.brickOf(t.inside());
+    const int count = beta.neighbours(cache.neighbourhood(brick, t.inside()).bits, t, neighbours);
     for (int k = 0; k < count; ++k) {
-      auto [w, isNew] = index.insert(neighbours[k], std::uint32_t(surfels.size()));
-      if (isNew) surfels.push_back(neighbours[k]);
-      targets.push_back(w);
+      const Place q = placeOf(neighbours[k], t.inside(), brick);
+      targets.push_back(visited.index(q.brick, q.bit));
     }
     rowStart.push_back(std::uint32_t(targets.size()));
-    if (progress && (v & 0xFFFFF) == 0xFFFFF) progress(surfels.size());
   }
   result.graph = makeSurfelGraph(std::move(rowStart), std::move(targets));
   return result;

@@ -1,0 +1,74 @@
+// The tracker's visited structure: for each brick of the image cache (8x8x8 voxels), one bit
+// per (voxel, normal) — 6 x 512 bits, 384 bytes — so marking a surfel touches the same few
+// cache lines as reading its neighbourhood. Once the traversal is over, a prefix count per
+// 64-bit word turns every bit into a dense vertex index (brick order, then bit order) in O(1),
+// with no hashing of surfels at all.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <vector>
+
+#include "Surfel.h"
+
+namespace surftrack {
+
+class BrickSurfelSet {
+ public:
+  static constexpr int kWords = 6 * 512 / 64;
+
+  /// The bit of surfel (c, n) whose 1-voxel c has coordinates `local` in [0, 8)^3 in its brick.
+  static int bitOf(Voxel local, Direction n) {
+    return n * 512 + local.z * 64 + local.y * 8 + local.x;
+  }
+
+  /// Marks the surfel; false if it was already marked.
+  bool insert(std::uint32_t brick, int bit) {
+    if (brick >= words_.size()) words_.resize(brick + 1, Words{});
+    std::uint64_t& w = words_[brick][bit >> 6];
+    const std::uint64_t m = std::uint64_t(1) << (bit & 63);
+    if (w & m) return false;
+    w |= m;
+    return true;
+  }
+
+  /// Freezes the set and numbers its surfels; returns their number.
+  std::uint32_t number() {
+    prefix_.resize(words_.size());
+    std::uint32_t count = 0;
+    for (std::size_t b = 0; b < words_.size(); ++b)
+      for (int w = 0; w < kWords; ++w) {
+        prefix_[b][w] = count;
+        count += std::uint32_t(std::popcount(words_[b][w]));
+      }
+    return count;
+  }
+
+  /// The vertex index of a marked surfel (after number()).
+  std::uint32_t index(std::uint32_t brick, int bit) const {
+    const std::uint64_t below = (std::uint64_t(1) << (bit & 63)) - 1;
+    return prefix_[brick][bit >> 6] + std::uint32_t(std::popcount(words_[brick][bit >> 6] & below));
+  }
+
+  /// Calls f(brick, bit) for every marked surfel, in index order.
+  template <class F>
+  void forEach(F&& f) const {
+    for (std::uint32_t b = 0; b < words_.size(); ++b)
+      for (int w = 0; w < kWords; ++w)
+        for (std::uint64_t bits = words_[b][w]; bits; bits &= bits - 1)
+          f(b, w * 64 + std::countr_zero(bits));
+  }
+
+  std::size_t bytes() const {
+    return words_.capacity() * sizeof(Words) + prefix_.capacity() * sizeof(Prefix);
+  }
+
+ private:
+  using Words = std::array<std::uint64_t, kWords>;
+  using Prefix = std::array<std::uint32_t, kWords>;
+  std::vector<Words> words_;
+  std::vector<Prefix> prefix_;
+};
+
+}  // namespace surftrack
