@@ -1,0 +1,18 @@
+// Writing a SurfaceMesh with OpenMesh's IO, the format chosen by the file extension.
+#pragma once
+
+#include <string>
+
+#include "SurfaceMesh.h"
+
+namespace surftrack {
+
+/// Writes `mesh` to `path`; the format follows the extension (case-insensitive): .ply, .obj,
+/// .off, .stl. `binary` applies to .ply and .stl (binary by default); .obj and .off are text.
+/// The file is written to a temporary file in the same directory, then renamed over `path`,
+/// so a failure never leaves a partial file.
+/// Throws std::invalid_argument for an unknown extension, std::runtime_error naming the path
+/// when it cannot be written.
+void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary = true);
+
+}  // namespace surftrack

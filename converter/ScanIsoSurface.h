@@ -1,0 +1,199 @@
+// The scanning method ("method 1" of Figure 9, paper §5.1): the kappa-lambda-iso-surface of a
+// whole binary image, built like marching cubes by visiting every digital 3-cube that meets the
+// domain and emitting the triangles of its configuration table entry. Vertex v of the result is
+// a boundary surfel, and every boundary surfel of the image is exactly one vertex.
+//
+// How it works (see ScanIsoSurface.cpp):
+//  - The image is read once, one row of voxels at a time, into bit sets (64 voxels a word; one
+//    bit per voxel of the domain padded by one voxel, 1/8 of a uint8 image). The surfels are
+//    counted (popcounts) so that the mesh is allocated once. The cubes of a row whose 8 corners
+//    are all equal (configurations 0x00 and 0xFF, the vast majority) are skipped by a few word
+//    operations per 64 cubes.
+//  - Vertices are shared between cubes without a global hash map (as in flying edges and
+//    OpenVDB's VolumeToMesh): before the cubes of a slab z..z+1 are visited, every cut grid edge
+//    of the slab gets its vertex index in small per-plane arrays indexed by edge position.
+//  - A dense ThresholdImage (any gray type, in particular the binaryView of a BinaryVolume) is
+//    binarised straight from its buffer, 16 uint8 voxels per SSE2 instruction; any other binary
+//    image (LabelImage, ImplicitImage, ...) is read through its operator().
+//
+// The image must be constant outside its domain (as every image of Image.h is): the cubes
+// scanned are those with min corner in [-1, n - 1] on each axis, so that every boundary is
+// closed, also where an object touches the domain border (spec.md §1).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
+#include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "AdjacencyPair.h"
+#include "Image.h"
+#include "Surfel.h"
+#include "TriangleMesh.h"
+
+namespace surftrack {
+
+namespace scan {
+
+/// In a row bit set, voxel x (for x in [-1, nx]) is bit x + kRowOffset: the voxels of the
+/// domain start on a word boundary and x = -1 is the top bit of word 0.
+inline constexpr int kRowOffset = 64;
+
+/// Words of one row bit set for a domain nx voxels wide (one spare zero word at the end).
+constexpr int rowWords(int nx) { return (nx + kRowOffset) / 64 + 2; }
+
+/// Where the scanner gets its voxels from, one row of x at a time.
+class RowSource {
+ public:
+  virtual ~RowSource() = default;
+  /// Sets bit x + kRowOffset of `row` (rowWords(nx) words, zero on entry) to the value of voxel
+  /// (x, y, z), for every x in [-1, nx]; y and z may lie one voxel outside the domain.
+  virtual void fillRow(int y, int z, std::uint64_t* row) const = 0;
+};
+
+/// The scanning engine: the kappa-lambda-iso-surface of the binary image that `rows`
+/// describes on the domain `dims` (cubes with min corner in [-1, n - 1] on each axis).
+TriangleMesh scanRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows);
+
+/// Rows of any binary image, one operator() call per voxel.
+template <class BinaryImage>
+class GenericRows final : public RowSource {
+ public:
+  explicit GenericRows(const BinaryImage& image) : image_(image), nx_(image.dims().nx) {}
+  void fillRow(int y, int z, std::uint64_t* row) const override {
+    for (int x = -1; x <= nx_; ++x)
+      if (image_(x, y, z)) row[(x + kRowOffset) >> 6] |= std::uint64_t(1) << ((x + kRowOffset) & 63);
+  }
+
+ private:
+  const BinaryImage& image_;
+  int nx_;
+};
+
+/// Rows of a ThresholdImage<T> (f > s), binarised straight from the gray buffer.
+template <class T>
+class ThresholdRows final : public RowSource {
+ public:
+  explicit ThresholdRows(const ThresholdImage<T>& image)
+      : gray_(image.gray()), dims_(image.dims()), iso_(image.isoValue()),
+        outside_(image(-1, -1, -1)) {
+    if constexpr (std::is_integral_v<T> && sizeof(T) <= 4) {
+      // For an integer f, f > s <=> f > floor(s); s below (above) the range: all 1 (all 0).
+      const double t = std::floor(iso_);
+      if (t < double(std::numeric_limits<T>::min())) mode_ = Mode::AllOnes;
+      else if (t >= double(std::numeric_limits<T>::max())) mode_ = Mode::AllZeros;
+      else threshold_ = T(t);
+    }
+  }
+
+  void fillRow(int y, int z, std::uint64_t* row) const override {
+    const int nx = dims_.nx;
+    if (outside_) {
+      setBit(row, -1);
+      setBit(row, nx);
+    }
+    if (!dims_.contains(0, y, z)) {  // a row of the one-voxel frame around the domain
+      if (outside_)
+        for (int x = 0; x < nx; ++x) setBit(row, x);
+      return;
+    }
+    const T* p = &gray_.at(0, y, z);
+    std::uint64_t* out = row + kRowOffset / 64;
+    int x = 0;
+    for (; x + 64 <= nx; x += 64) *out++ |= block(p + x, 64);
+    if (x < nx) *out |= block(p + x, nx - x);  // this word may hold the bit of x = nx
+  }
+
+ private:
+  enum class Mode { Compare, AllOnes, AllZeros };
+
+  static void setBit(std::uint64_t* row, int x) {
+    row[(x + kRowOffset) >> 6] |= std::uint64_t(1) << ((x + kRowOffset) & 63);
+  }
+
+  /// Bit i is p[i] > s, for i < n <= 64.
+  std::uint64_t block(const T* p, int n) const {
+    if (mode_ == Mode::AllOnes) return n == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1;
+    if (mode_ == Mode::AllZeros) return 0;
+    std::uint64_t bits = 0;
+    int i = 0;
+    if constexpr (std::is_same_v<T, std::uint8_t>) {
+#if defined(__SSE2__)
+      // Unsigned bytes compared as signed after flipping their top bit.
+      const __m128i flip = _mm_set1_epi8(char(0x80));
+      const __m128i t = _mm_set1_epi8(char(threshold_ ^ 0x80));
+      for (; i + 16 <= n; i += 16) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + i));
+        const int mask = _mm_movemask_epi8(_mm_cmpgt_epi8(_mm_xor_si128(v, flip), t));
+        bits |= std::uint64_t(std::uint16_t(mask)) << i;
+      }
+#endif
+    }
+    for (; i < n; ++i) bits |= std::uint64_t(above(p[i])) << i;
+    return bits;
+  }
+
+  bool above(T value) const {
+    if constexpr (std::is_integral_v<T> && sizeof(T) <= 4) return value > threshold_;
+    else return double(value) > iso_;  // exactly ThresholdImage's test
+  }
+
+  const DenseImage<T>& gray_;
+  Dims dims_;
+  double iso_;
+  bool outside_;
+  Mode mode_ = Mode::Compare;
+  T threshold_{};
+};
+
+template <class Image>
+struct IsThresholdImage : std::false_type {};
+template <class T>
+struct IsThresholdImage<ThresholdImage<T>> : std::true_type {};
+
+}  // namespace scan
+
+/// The kappa-lambda-iso-surface of a binary image through its generic operator() (any image).
+template <class BinaryImage>
+TriangleMesh scanIsoSurfaceGeneric(const BinaryImage& image, AdjacencyPair pair) {
+  return scan::scanRows(image.dims(), pair, scan::GenericRows<BinaryImage>(image));
+}
+
+/// The kappa-lambda-iso-surface of a whole binary image (paper §5.1): the triangles of the
+/// configuration table of `pair` in every digital 3-cube meeting the domain, oriented from the
+/// 1-voxels to the 0-voxels, one vertex per boundary surfel. Uses the fast row binariser for a
+/// ThresholdImage (and so for binaryView), the generic path otherwise; both give the same mesh.
+template <class BinaryImage>
+TriangleMesh scanIsoSurface(const BinaryImage& image, AdjacencyPair pair) {
+  if constexpr (scan::IsThresholdImage<BinaryImage>::value)
+    return scan::scanRows(image.dims(), pair, scan::ThresholdRows(image));
+  else
+    return scanIsoSurfaceGeneric(image, pair);
+}
+
+/// Connected components of a mesh's triangles through shared vertices: returns the component
+/// of every vertex (a triangle's component is that of its vertices), numbered 0, 1, ... in the
+/// order of their smallest vertex; `count` receives the number of components. On a scanned
+/// mesh the components are exactly the kappa-lambda-boundaries (Proposition 39).
+std::vector<std::uint32_t> meshComponents(const TriangleMesh& mesh, std::size_t& count);
+
+/// The component of `mesh` that contains the vertex of `seed`, vertices renumbered in their
+/// original order ("method 1b": what a marching-cubes user must do to get one boundary).
+/// Throws std::invalid_argument if seed is not a vertex of the mesh.
+TriangleMesh extractComponent(const TriangleMesh& mesh, const Surfel& seed);
+
+/// Every component of `mesh` as a mesh of its own, in the order of meshComponents.
+std::vector<TriangleMesh> splitComponents(const TriangleMesh& mesh);
+
+/// The kappa-lambda-iso-surface of each kappa-lambda-boundary of the image.
+template <class BinaryImage>
+std::vector<TriangleMesh> scanComponents(const BinaryImage& image, AdjacencyPair pair) {
+  return splitComponents(scanIsoSurface(image, pair));
+}
+
+}  // namespace surftrack

@@ -1,0 +1,520 @@
+// extractLoops (paper §5.2), the boundary mappings (§3.1), the OpenMesh conversion and mesh
+// files, checked against references that do not use the converter: the boundaries come from
+// scanBoundaries and from voxel components (VoxelComponents.h), the Euler characteristics from
+// cell counts on the voxels, the orientation from exact-enough solid-angle winding numbers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <numbers>
+#include <random>
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+
+#include "BoundaryMapping.h"
+#include "LoopExtraction.h"
+#include "MeshIO.h"
+#include "ScanBoundaries.h"
+#include "SurfaceMesh.h"
+#include "TrackComponent.h"
+#include "VoxelComponents.h"
+
+namespace surftrack {
+// gtest prints the parameter of AllPairs/... as "26-6" instead of its bytes.
+inline void PrintTo(AdjacencyPair pair, std::ostream* os) { *os << toString(pair); }
+}  // namespace surftrack
+
+using namespace surftrack;
+namespace ref = surftrack::testing;
+using Point = std::array<double, 3>;
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Combinatorial checks on an indexed mesh.
+
+/// Closed, consistently oriented 2-manifold whose vertex set is exactly `boundaryKeys`:
+///  - every triangle has 3 distinct vertices, no triangle is repeated;
+///  - every directed edge is used once and its reverse once (each undirected edge by exactly two
+///    triangles, in opposite directions);
+///  - the star of every vertex is one disc: its triangles (v, a, b) chain a -> b into one cycle;
+///  - the surfels are the boundary's, each once, every vertex used.
+/// On success `euler` is V - E + F.
+::testing::AssertionResult isClosedManifoldOn(const TriangleMesh& mesh,
+                                              const std::vector<std::uint64_t>& boundaryKeys,
+                                              long* euler = nullptr) {
+  const std::size_t V = mesh.surfels.size();
+  std::vector<std::uint64_t> keys = ref::sortedKeys(mesh.surfels);
+  if (std::adjacent_find(keys.begin(), keys.end()) != keys.end())
+    return ::testing::AssertionFailure() << "a surfel is two vertices";
+  if (keys != boundaryKeys)
+    return ::testing::AssertionFailure() << "vertex set (" << V << ") differs from the boundary ("
+                                         << boundaryKeys.size() << " surfels)";
+  std::vector<std::array<std::uint32_t, 3>> sortedTriangles;
+  std::vector<std::uint64_t> directed;  // (a << 32) | b for every triangle edge a -> b
+  std::vector<std::array<std::uint32_t, 3>> corners;  // (v, a, b) for every triangle (v, a, b)
+  for (const auto& t : mesh.triangles) {
+    for (std::uint32_t v : t)
+      if (v >= V) return ::testing::AssertionFailure() << "vertex index out of range";
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
+      return ::testing::AssertionFailure() << "degenerate triangle " << t[0] << "," << t[1] << "," << t[2];
+    std::array<std::uint32_t, 3> sorted = t;
+    std::sort(sorted.begin(), sorted.end());
+    sortedTriangles.push_back(sorted);
+    for (int j = 0; j < 3; ++j) {
+      directed.push_back((std::uint64_t(t[j]) << 32) | t[(j + 1) % 3]);
+      corners.push_back({t[j], t[(j + 1) % 3], t[(j + 2) % 3]});
+    }
+  }
+  std::sort(sortedTriangles.begin(), sortedTriangles.end());
+  if (std::adjacent_find(sortedTriangles.begin(), sortedTriangles.end()) != sortedTriangles.end())
+    return ::testing::AssertionFailure() << "repeated triangle";
+  std::sort(directed.begin(), directed.end());
+  if (auto it = std::adjacent_find(directed.begin(), directed.end()); it != directed.end())
+    return ::testing::AssertionFailure() << "directed edge " << (*it >> 32) << "->"
+                                         << (*it & 0xFFFFFFFFu) << " used twice";
+  for (std::uint64_t key : directed)
+    if (!std::binary_search(directed.begin(), directed.end(), (key << 32) | (key >> 32)))
+      return ::testing::AssertionFailure() << "edge " << (key >> 32) << "->" << (key & 0xFFFFFFFFu)
+                                           << " has one triangle only (or a misoriented one)";
+  // Star of v: its corners (v, a, b) sorted by a; a -> b must be one cycle through all of them.
+  std::sort(corners.begin(), corners.end());
+  std::size_t begin = 0;
+  for (std::uint32_t v = 0; v < V; ++v) {
+    std::size_t end = begin;
+    while (end < corners.size() && corners[end][0] == v) ++end;
+    if (end == begin) return ::testing::AssertionFailure() << "vertex " << v << " is unused";
+    const auto first = corners.begin() + begin, last = corners.begin() + end;
+    std::uint32_t a = (*first)[1];
+    std::size_t steps = 0;
+    do {
+      const auto it = std::lower_bound(first, last, std::array<std::uint32_t, 3>{v, a, 0});
+      if (it == last || (*it)[1] != a) return ::testing::AssertionFailure() << "star of " << v << " is open";
+      a = (*it)[2];
+    } while (++steps <= end - begin && a != (*first)[1]);
+    if (steps != end - begin)
+      return ::testing::AssertionFailure() << "star of vertex " << v << " (" << mesh.surfels[v]
+                                           << ") is not one disc";
+    begin = end;
+  }
+  if (euler) *euler = long(V) - long(directed.size() / 2) + long(mesh.triangles.size());
+  return ::testing::AssertionSuccess();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geometry: signed volume and winding numbers.
+
+double signedVolume(const TriangleMesh& mesh, const std::vector<Point>& p) {
+  double volume = 0;
+  for (const auto& t : mesh.triangles) {
+    const Point &a = p[t[0]], &b = p[t[1]], &c = p[t[2]];
+    volume += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+              a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  return volume / 6;
+}
+
+/// Sum of the signed solid angles of the triangles seen from q, over 4 pi (Van Oosterom and
+/// Strackee): +1 inside a closed surface oriented outward, 0 outside.
+double windingNumber(const TriangleMesh& mesh, const std::vector<Point>& p, const Point& q) {
+  double total = 0;
+  for (const auto& t : mesh.triangles) {
+    Point v[3];
+    double len[3];
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) v[j][k] = p[t[j]][k] - q[k];
+      len[j] = std::sqrt(v[j][0] * v[j][0] + v[j][1] * v[j][1] + v[j][2] * v[j][2]);
+    }
+    auto dot = [](const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+    const double det = v[0][0] * (v[1][1] * v[2][2] - v[1][2] * v[2][1]) -
+                       v[0][1] * (v[1][0] * v[2][2] - v[1][2] * v[2][0]) +
+                       v[0][2] * (v[1][0] * v[2][1] - v[1][1] * v[2][0]);
+    const double den = len[0] * len[1] * len[2] + dot(v[0], v[1]) * len[2] +
+                       dot(v[0], v[2]) * len[1] + dot(v[1], v[2]) * len[0];
+    total += 2 * std::atan2(det, den);
+  }
+  return total / (4 * std::numbers::pi);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Euler characteristic of a kappa-component O, from its voxels only (spec §8).
+
+/// kappa = 26: the union of the closed unit cubes centred at O's voxels. In doubled coordinates
+/// its cells are the points 2v + {-1,0,1}^3; a cell's dimension is its number of even coordinates.
+/// kappa = 6: the cubical complex whose cells are the boxes v + {0,1}^S (S a set of axes) with all
+/// 2^|S| voxels in O: vertices, 6-adjacent pairs, 2x2 squares, 2x2x2 cubes.
+/// The pairs 18-6 and 6-18 differ from 26-6 and 6-26 only in the strict 26-configurations
+/// (Def. 38 (iv)): the only 2x2x2 blocks whose 1-voxels (0-voxels) are two kappa-components
+/// (lambda-components) when kappa = 18 (lambda = 18). There the 26-6 complex joins the two
+/// corner cubes at one point, which the 18-6 solid splits: chi grows by 1 per such block with
+/// both corners in O (chi(A u B) = chi(A) + chi(B) - chi(point)). And the 6-26 complex has an
+/// empty hexagon of six 6-adjacent voxels around the two 0-corners linked through the cube,
+/// which the 6-18 solid fills with a disc: chi grows by 1 per such block with its six 1-voxels
+/// in O.
+long voxelEuler(const std::vector<Voxel>& O, const ref::VoxelComponents& voxels, int component,
+                AdjacencyPair pair) {
+  auto inO = [&](Voxel v) { return voxels.value(v) && voxels.component(v) == component; };
+  long chi = 0;
+  if (kappa(pair) != 6) {
+    std::vector<std::uint64_t> cells;
+    for (const Voxel& v : O)
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            cells.push_back(Surfel{Voxel{2 * v.x + dx, 2 * v.y + dy, 2 * v.z + dz}, 0}.key());
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    for (std::uint64_t k : cells) {
+      const Voxel c = Surfel::fromKey(k).c;
+      const int even = (c.x % 2 == 0) + (c.y % 2 == 0) + (c.z % 2 == 0);
+      chi += (even % 2 == 0) ? 1 : -1;
+    }
+  } else {
+    for (const Voxel& v : O)
+      for (int axes = 0; axes < 8; ++axes) {
+        bool all = true;
+        for (int corner = 0; corner < 8 && all; ++corner)
+          if ((corner & ~axes) == 0) all = inO(v + cube::cornerOffset(corner));
+        if (all) chi += (std::popcount(unsigned(axes)) % 2 == 0) ? 1 : -1;
+      }
+  }
+  if (pair == AdjacencyPair::k18_6 || pair == AdjacencyPair::k6_18) {
+    // Blocks with a corner in O: min corners O - {0,1}^3.
+    std::vector<std::uint64_t> blocks;
+    for (const Voxel& v : O)
+      for (int corner = 0; corner < 8; ++corner) blocks.push_back(Surfel{v - cube::cornerOffset(corner), 0}.key());
+    std::sort(blocks.begin(), blocks.end());
+    blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
+    for (std::uint64_t k : blocks) {
+      const Voxel m = Surfel::fromKey(k).c;
+      int inside = 0;
+      std::uint8_t config = 0;
+      for (int corner = 0; corner < 8; ++corner) {
+        const Voxel w = m + cube::cornerOffset(corner);
+        const bool one = voxels.value(w);
+        config |= std::uint8_t(one << corner);
+        inside += one && inO(w);
+      }
+      for (int i = 0; i < 4; ++i) {
+        const std::uint8_t diagonal = std::uint8_t((1u << i) | (1u << (7 - i)));
+        if (pair == AdjacencyPair::k18_6 && config == diagonal && inside == 2) ++chi;
+        if (pair == AdjacencyPair::k6_18 && config == std::uint8_t(~diagonal) && inside == 6) ++chi;
+      }
+    }
+  }
+  return chi;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The whole check of one binary image under one pair.
+
+struct Checks {
+  bool winding = false;   // winding numbers at every voxel of O and Q (costly)
+  bool openMesh = false;  // build the OpenMesh mesh and check it has no boundary
+};
+
+struct ImageStats {
+  std::size_t boundaries = 0, triangles = 0, windingVoxels = 0;
+};
+
+ImageStats checkImage(const BinaryVolume& volume, AdjacencyPair pair, Checks checks,
+                      const std::string& name) {
+  SCOPED_TRACE(name + " pair " + toString(pair));
+  ImageStats stats;
+  const auto image = binaryView(volume);
+  const BoundaryPartition partition = scanBoundaries(image, pair);
+  const ref::VoxelComponents voxels(image, pair);
+  const Dims& dims = volume.dims();
+  const int outside = voxels.component(Voxel{-1, -1, -1});
+  std::map<int, long> eulerSum;  // 1-component -> sum of chi of its boundaries' meshes
+
+  for (const std::vector<Surfel>& boundary : partition.components()) {
+    const std::vector<std::uint64_t> keys = ref::sortedKeys(boundary);
+    const SurfaceGraph graph = trackComponent(image, boundary.front(), pair);
+    const TriangleMesh mesh = extractLoops(image, graph);
+    EXPECT_EQ(mesh.surfels, graph.surfels) << "vertex v must be graph vertex v";
+    long euler = 0;
+    const auto manifold = isClosedManifoldOn(mesh, keys, &euler);
+    EXPECT_TRUE(manifold);
+    if (!manifold) return stats;
+    ++stats.boundaries;
+    stats.triangles += mesh.triangles.size();
+
+    const int O = voxels.component(boundary.front().inside());
+    const int Q = voxels.component(boundary.front().outside());
+    eulerSum[O] += euler;
+    const std::vector<Point> positions = mapVertices(mesh, MidpointMapping{});
+    const double volumeSign = signedVolume(mesh, positions);
+    EXPECT_EQ(volumeSign > 0, Q == outside) << "signed volume " << volumeSign;
+    EXPECT_NE(volumeSign, 0.0);
+
+    if (checks.winding) {
+      // O lies inside the closed surface iff Q is the unbounded component; the surface is
+      // oriented from O to Q, so the side inside gets winding +1 (O) or -1 (a cavity Q).
+      const bool outer = Q == outside;
+      for (int z = -1; z <= dims.nz; ++z)
+        for (int y = -1; y <= dims.ny; ++y)
+          for (int x = -1; x <= dims.nx; ++x) {
+            const Voxel v{x, y, z};
+            const int c = voxels.component(v);
+            const bool inO = voxels.value(v) && c == O, inQ = !voxels.value(v) && c == Q;
+            if (!inO && !inQ) continue;
+            const double expected = inO ? (outer ? 1 : 0) : (outer ? 0 : -1);
+            const double w = windingNumber(mesh, positions, {double(x), double(y), double(z)});
+            EXPECT_NEAR(w, expected, 1e-6) << "voxel " << v << (inO ? " of O" : " of Q");
+            ++stats.windingVoxels;
+          }
+    }
+    if (checks.openMesh) {
+      SurfaceMesh om;
+      EXPECT_NO_THROW(om = toSurfaceMesh(mesh, positions));
+      EXPECT_EQ(om.n_vertices(), mesh.surfels.size());
+      EXPECT_EQ(om.n_faces(), mesh.triangles.size());
+      for (auto heh : om.halfedges()) EXPECT_FALSE(om.is_boundary(heh));
+      for (auto vh : om.vertices()) EXPECT_TRUE(om.is_manifold(vh));
+    }
+  }
+
+  // Euler: sum over the boundaries of each kappa-component O of chi = 2 chi(O).
+  std::map<int, std::vector<Voxel>> components;
+  for (int z = 0; z < dims.nz; ++z)
+    for (int y = 0; y < dims.ny; ++y)
+      for (int x = 0; x < dims.nx; ++x)
+        if (volume.at(x, y, z)) components[voxels.component({x, y, z})].push_back({x, y, z});
+  for (const auto& [O, members] : components)
+    EXPECT_EQ(eulerSum[O], 2 * voxelEuler(members, voxels, O, pair)) << "component of " << members.front();
+  return stats;
+}
+
+std::string pairName(const ::testing::TestParamInfo<AdjacencyPair>& info) {
+  return "k" + std::to_string(kappa(info.param)) + "_" + std::to_string(lambda(info.param));
+}
+
+class LoopExtraction : public ::testing::TestWithParam<AdjacencyPair> {};
+
+// ---------------------------------------------------------------------------------------------
+
+TEST_P(LoopExtraction, EveryConfigurationOfA2x2x2And2x2x3Block) {
+  ImageStats total;
+  for (Dims dims : {Dims{2, 2, 2}, Dims{2, 2, 3}, Dims{3, 2, 2}, Dims{2, 3, 2}}) {
+    const std::uint64_t count = std::uint64_t(1) << dims.count();
+    for (std::uint64_t bits = 0; bits < count; ++bits) {
+      const auto stats = checkImage(ref::volumeFromBits(dims, bits), GetParam(), {true, bits % 16 == 0},
+                                    "block " + std::to_string(dims.nx) + "x" + std::to_string(dims.ny) +
+                                        "x" + std::to_string(dims.nz) + " bits " + std::to_string(bits));
+      total.boundaries += stats.boundaries;
+      total.windingVoxels += stats.windingVoxels;
+      if (HasFailure()) return;
+    }
+  }
+  EXPECT_GT(total.boundaries, 4096u);
+  EXPECT_GT(total.windingVoxels, 100000u);
+}
+
+TEST_P(LoopExtraction, ThousandRandomImages) {
+  ImageStats total;
+  for (int i = 0; i < 1000; ++i) {
+    const int side = 3 + i % 14;
+    const double density = 0.1 + 0.8 * (i % 17) / 16.0;
+    const Checks checks{side <= 6, i % 5 == 0};
+    const auto stats = checkImage(ref::randomVolume({side, side, side}, density, 7000u + i), GetParam(),
+                                  checks, "random image " + std::to_string(i));
+    total.boundaries += stats.boundaries;
+    total.triangles += stats.triangles;
+    if (HasFailure()) return;
+  }
+  EXPECT_GT(total.boundaries, 5000u);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllPairs, LoopExtraction, ::testing::ValuesIn(kAllAdjacencyPairs), pairName);
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(LoopExtractionErrors, GraphOfAnotherImageIsRejected) {
+  BinaryVolume a({3, 3, 3});
+  a.at(0, 0, 0) = a.at(1, 1, 1) = 1;  // a strict 26-configuration of 1-voxels
+  const auto image = binaryView(a);
+  SurfaceGraph graph = trackComponent(image, Surfel{{0, 0, 0}, 1}, AdjacencyPair::k26_6);
+  EXPECT_NO_THROW(extractLoops(image, graph));
+  // Tracked with 18-6, the two cubes are separate boundaries: the tube has no vertex links.
+  SurfaceGraph split = trackComponent(image, Surfel{{0, 0, 0}, 1}, AdjacencyPair::k18_6);
+  split.pair = AdjacencyPair::k26_6;
+  EXPECT_THROW(extractLoops(image, split), std::logic_error);
+  // A voxel of the tracked surface removed.
+  BinaryVolume b = a;
+  b.at(1, 1, 1) = 0;
+  EXPECT_THROW(extractLoops(binaryView(b), graph), std::logic_error);
+  try {
+    extractLoops(binaryView(b), graph);
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("does not match the image"), std::string::npos) << e.what();
+  }
+}
+
+TEST(LoopExtractionCost, ReadsVoxelsInProportionToTheSurfaceOnly) {
+  // A ball in a 2^18-sided domain: anything O(volume) would never finish.
+  std::size_t reads = 0;
+  const int c = 1 << 17;
+  const ImplicitImage ball({1 << 18, 1 << 18, 1 << 18}, [&](int x, int y, int z) {
+    ++reads;
+    const long dx = x - c, dy = y - c, dz = z - c;
+    return dx * dx + dy * dy + dz * dz <= 30L * 30L;
+  });
+  const SurfaceGraph graph = trackComponent(ball, Surfel{{c + 30, c, c}, 0}, AdjacencyPair::k26_6);
+  reads = 0;
+  const TriangleMesh mesh = extractLoops(ball, graph);
+  EXPECT_LE(reads, 4 * 8 * graph.surfelCount());
+  EXPECT_TRUE(isClosedManifoldOn(mesh, ref::sortedKeys(graph.surfels)));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Gray images and the iso-value mapping.
+
+TEST(IsoValueMapping, ValuesEqualToTheIsoValueNeverMergeVertices) {
+  const double s = 100;
+  std::size_t clamped = 0;
+  ImageGeometry geometry;
+  geometry.spacing = {0.5, 2.0, 1.25};
+  geometry.origin = {10, -3, 7};
+  geometry.direction = {{{0, 1, 0}, {-1, 0, 0}, {0, 0, 1}}};
+  for (int i = 0; i < 60; ++i) {
+    const int side = 4 + i % 7;
+    DenseImage<std::uint8_t> gray({side, side + 1, side});
+    std::mt19937 rng(500 + i);
+    std::uniform_int_distribution<int> level(0, 4);
+    for (auto& f : gray.data()) f = std::uint8_t(80 + 10 * level(rng));  // 80 .. 120, 100 = s
+    const ThresholdImage<std::uint8_t> image(gray, s);
+    const IsoValueMapping mapping(image);
+    for (AdjacencyPair pair : kAllAdjacencyPairs) {
+      SCOPED_TRACE("gray image " + std::to_string(i) + " pair " + toString(pair));
+      std::vector<Point> all;
+      for (const auto& boundary : scanBoundaries(image, pair).components()) {
+        const SurfaceGraph graph = trackComponent(image, boundary.front(), pair);
+        const TriangleMesh mesh = extractLoops(image, graph);
+        ASSERT_TRUE(isClosedManifoldOn(mesh, ref::sortedKeys(boundary)));
+        for (const Surfel& t : mesh.surfels) {
+          const Point p = mapping(t);
+          const Voxel c = t.inside(), d = t.outside();
+          const int a = axisOf(t.n);
+          const double along = (p[a] - c[a]) * signOf(t.n);  // in ]0, 1[ strictly
+          EXPECT_GT(along, 0.0);
+          EXPECT_LT(along, 1.0);
+          for (int k = 0; k < 3; ++k)
+            if (k != a) {
+              EXPECT_EQ(p[k], double(c[k]));
+            }
+          if (gray.dims().contains(d) && gray.at(d) == s) {
+            ++clamped;
+            EXPECT_NEAR(along, 1 - IsoValueMapping<std::uint8_t>::kDefaultEpsilon, 1e-12);
+          }
+          all.push_back(p);
+        }
+        // Same connectivity as the midpoint mesh, vertices moved only; physical placement.
+        const SurfaceMesh om = toMesh(graph, image, mapping, geometry);
+        const SurfaceMesh mid = toMesh(graph, image, MidpointMapping{});
+        ASSERT_EQ(om.n_faces(), mesh.triangles.size());
+        ASSERT_EQ(om.n_vertices(), mesh.surfels.size());
+        for (auto heh : om.halfedges()) EXPECT_FALSE(om.is_boundary(heh));
+        for (auto fh : om.faces()) {
+          std::vector<int> f, g;
+          for (auto vh : om.fv_range(fh)) f.push_back(vh.idx());
+          for (auto vh : mid.fv_range(mid.face_handle(fh.idx()))) g.push_back(vh.idx());
+          EXPECT_EQ(f, g);
+        }
+        for (auto vh : om.vertices()) {
+          EXPECT_EQ(surfelOf(om, vh), mesh.surfels[vh.idx()]);
+          const Point q = geometry.toPhysical(mapping(mesh.surfels[vh.idx()]));
+          const auto& r = om.point(vh);
+          EXPECT_EQ((std::array<double, 3>{r[0], r[1], r[2]}), q);
+        }
+      }
+      std::sort(all.begin(), all.end());
+      EXPECT_EQ(std::adjacent_find(all.begin(), all.end()), all.end()) << "two vertices coincide";
+    }
+  }
+  EXPECT_GT(clamped, 1000u) << "the test must exercise f(d) = s";
+}
+
+TEST(IsoValueMapping, InterpolatesLinearlyAndFallsBackToTheMidpointOutsideTheDomain) {
+  DenseImage<float> gray({2, 1, 1});
+  gray.at(0, 0, 0) = 10;
+  gray.at(1, 0, 0) = 0;
+  const IsoValueMapping<float> mapping(gray, 7.5);
+  EXPECT_DOUBLE_EQ(mapping.parameter(Surfel{{0, 0, 0}, 0}), 0.25);
+  EXPECT_DOUBLE_EQ(mapping(Surfel{{0, 0, 0}, 0})[0], 0.25);
+  EXPECT_DOUBLE_EQ(mapping.parameter(Surfel{{0, 0, 0}, 1}), 0.5);  // d = (-1, 0, 0) is outside
+  EXPECT_THROW(IsoValueMapping<float>(gray, 7.5, 0.0), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Mesh files.
+
+class MeshFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("surftrack_test_loop_extraction_" + std::to_string(std::random_device{}()));
+    std::filesystem::create_directories(dir_);
+    BinaryVolume volume({3, 3, 3});
+    for (auto& f : volume.data()) f = 1;
+    volume.at(1, 1, 1) = 0;  // a cavity: two boundaries; use the outer one
+    volume.at(0, 0, 0) = 0;
+    const auto image = binaryView(volume);
+    mesh_ = toMesh(trackComponent(image, Surfel{{2, 2, 2}, 0}, AdjacencyPair::k26_6), image,
+                   MidpointMapping{});
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::size_t filesInDir() const {
+    return std::distance(std::filesystem::directory_iterator(dir_), std::filesystem::directory_iterator{});
+  }
+
+  std::filesystem::path dir_;
+  SurfaceMesh mesh_;
+};
+
+TEST_F(MeshFiles, RoundTripThroughOpenMesh) {
+  ASSERT_GT(mesh_.n_faces(), 0u);
+  struct Case {
+    std::string name;
+    bool binary;
+  };
+  const std::vector<Case> cases = {{"a.ply", true}, {"b.ply", false}, {"c.obj", true},
+                                   {"d.off", true}, {"e.stl", true},  {"f.stl", false},
+                                   {"G.PLY", true}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = (dir_ / c.name).string();
+    writeMesh(mesh_, path, c.binary);
+    SurfaceMesh back;
+    OpenMesh::IO::Options options;
+    if (c.binary) options += OpenMesh::IO::Options::Binary;
+    ASSERT_TRUE(OpenMesh::IO::read_mesh(back, path, options));
+    EXPECT_EQ(back.n_faces(), mesh_.n_faces());
+    if (c.name.find(".stl") == std::string::npos) {
+      EXPECT_EQ(back.n_vertices(), mesh_.n_vertices());
+    }
+  }
+  EXPECT_EQ(filesInDir(), cases.size()) << "no temporary file may remain";
+}
+
+TEST_F(MeshFiles, UnknownExtensionAndUnwritablePathThrowAndLeaveNoFile) {
+  EXPECT_THROW(writeMesh(mesh_, (dir_ / "mesh.xyz").string()), std::invalid_argument);
+  EXPECT_THROW(writeMesh(mesh_, (dir_ / "mesh").string()), std::invalid_argument);
+  const std::string missing = (dir_ / "no" / "such" / "dir" / "mesh.ply").string();
+  try {
+    writeMesh(mesh_, missing);
+    ADD_FAILURE() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+  }
+  // A directory in the way of the final rename: the temporary file must be removed.
+  std::filesystem::create_directory(dir_ / "taken.ply");
+  std::filesystem::create_directory(dir_ / "taken.ply" / "x");
+  EXPECT_THROW(writeMesh(mesh_, (dir_ / "taken.ply").string()), std::runtime_error);
+  EXPECT_EQ(filesInDir(), 1u) << "only the directory 'taken.ply' may remain";
+}
+
+}  // namespace
