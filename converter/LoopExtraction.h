@@ -6,8 +6,8 @@
 // loop's arcs give the graph vertex on each of those edges. Each (surfel, cube) pair carries a
 // flag, so each patch is emitted exactly once.
 //
-// Cost: O(1) per (surfel, cube) — 8 voxel reads, a table look-up, a walk over at most 6
-// surfels' arcs — hence O(|Sigma|) overall. Nothing is sized by the volume and no surfel is
+// Cost: O(1) per (surfel, cube) — a configuration from the brick cache, a table look-up, a
+// walk over at most 6 surfels' arcs — hence O(|Sigma|) overall. Nothing is sized by the volume and no surfel is
 // ever searched for: vertices are resolved through the arcs.
 #pragma once
 
@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "BinaryBrickCache.h"
 #include "ConfigurationTable.h"
 #include "DigitalCube.h"
 #include "SurfaceGraph.h"
@@ -59,13 +60,18 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
   // flags[v] bit q: the patch of surfel v in cube cubesOf(surfels[v])[q] has been emitted.
   std::vector<std::uint8_t> flags(surfels.size(), 0);
 
+  // The 4 cubes around a surfel lie in the 3x3x3 neighbourhood of its 1-voxel: read them from
+  // the tracker's brick cache rather than voxel by voxel from the image.
+  BinaryBrickCache<BinaryImage> cache(image);
   for (std::uint32_t v = 0; v < surfels.size(); ++v) {
     const Surfel& t = surfels[v];
+    if (flags[v] == 0xF) continue;
     const std::array<Voxel, 4> cubes = cube::cubesOf(t);
+    const Neighbourhood around = cache.neighbourhood(t.inside());
     for (int q = 0; q < 4; ++q) {
       if (flags[v] & (1u << q)) continue;
       const Voxel m = cubes[q];
-      const std::uint8_t config = cube::configurationAt(image, m);
+      const std::uint8_t config = cube::configurationAt(around, m);
       const CubeTriangulation& table = configurationTable(graph.pair, config);
       const int edge = cube::edgeOf(m, t);  // in 0..11: m is one of t's cubes
       const int patch = edge < 0 ? -1 : table.patchOfEdge[edge];

@@ -24,6 +24,7 @@ struct Neighbourhood {
 
   static constexpr int bitOf(Voxel d) { return (d.x + 1) + 3 * (d.y + 1) + 9 * (d.z + 1); }
   bool operator()(Voxel v) const { return (bits >> bitOf(v - center)) & 1u; }
+  bool operator()(int x, int y, int z) const { return (*this)(Voxel{x, y, z}); }
 };
 
 template <class BinaryImage>
