@@ -1,13 +1,16 @@
 // The scanning engine of ScanIsoSurface.h. It reads the binary image once into bit sets (one
 // bit per voxel, planes z = -1 .. nz), counts the boundary surfels to allocate the mesh once,
-// then visits the slabs z..z+1 in order: number the cut edges of the slab, then emit the
-// triangles of its non-trivial cubes. Index conventions used throughout:
+// then visits the slabs z..z+1 in order, and each slab row by row: give the cut edges of row j
+// their vertex indices, then emit the triangles of the non-trivial cubes of row j - 1 (whose
+// edges lie in rows j - 1 and j). Index conventions used throughout:
 //  - rows of a plane are numbered j = y + 1 for y in [-1, ny], so a plane has ny + 2 rows;
 //  - in a row bit set, voxel x is bit b = x + kRowOffset (see ScanIsoSurface.h);
-//  - in the vertex-index arrays, the grid edge whose low voxel is x has column i = x + 1.
+//  - in the vertex-index arrays, the grid edge whose low voxel is x has column i = x + 1; the
+//    x- and y-edges of the two planes of the slab are kept for whole planes (the top plane is
+//    the bottom plane of the next slab), the z-edges for two rows only.
 // The cube with min corner (x, y, z) has its corners in rows j, j + 1 of planes z, z + 1, bits
 // b, b + 1. Its 12 edges (DigitalCube.h) lie in the two planes (x- and y-edges) or between
-// them (z-edges); each cut edge got its vertex index before the slab's cubes are visited.
+// them (z-edges); each cut edge gets its vertex index before the first cube around it is visited.
 #include "ScanIsoSurface.h"
 
 #include <algorithm>
@@ -89,7 +92,7 @@ class Scanner {
       p->x.assign(std::size_t(rowCount_) * columns_, 0);
       p->y.assign(std::size_t(rowCount_) * columns_, 0);
     }
-    zEdge_.assign(std::size_t(rowCount_) * columns_, 0);
+    zEdge_.assign(2 * columns_, 0);
   }
 
   TriangleMesh run() {
@@ -98,11 +101,15 @@ class Scanner {
     const std::size_t surfels = countSurfels();
     mesh_.surfels.reserve(surfels);
     mesh_.triangles.reserve(2 * surfels);
-    numberPlaneEdges(-1, bottom_);
+    for (int j = 0; j < rowCount_; ++j) numberPlaneEdges(-1, j, bottom_);
     for (int z = -1; z < dims_.nz; ++z) {
-      numberPlaneEdges(z + 1, top_);
-      numberSlabEdges(z);
-      marchSlab(z);
+      // Row by row, so that the indices just written are still in cache when read: the cubes
+      // of row j need the edges of rows j and j + 1.
+      for (int j = 0; j < rowCount_; ++j) {
+        numberPlaneEdges(z + 1, j, top_);
+        numberSlabEdges(z, j);
+        if (j > 0) marchRow(z, j - 1);
+      }
       std::swap(bottom_, top_);
     }
     return std::move(mesh_);
@@ -151,68 +158,64 @@ class Scanner {
     return Surfel{high, directionOf(axis, -1)};
   }
 
-  /// Vertex indices for the cut x- and y-edges of plane z.
-  void numberPlaneEdges(int z, PlaneEdges& ids) {
-    for (int j = 0; j < rowCount_; ++j) {
-      const std::uint64_t* r = row(z, j);
-      const std::uint64_t* up = j + 1 < rowCount_ ? row(z, j + 1) : nullptr;
-      std::uint32_t* xIds = ids.x.data() + std::size_t(j) * columns_;
-      std::uint32_t* yIds = ids.y.data() + std::size_t(j) * columns_;
-      const int y = j - 1;
-      for (int w = 0; w < words_ - 1; ++w) {
-        forEachBit((r[w] ^ nextBits(r, w)) & cubeMask_[w], w, [&](int b) {
+  /// Vertex indices for the cut x- and y-edges of row j (y = j - 1) of plane z.
+  void numberPlaneEdges(int z, int j, PlaneEdges& ids) {
+    const std::uint64_t* r = row(z, j);
+    const std::uint64_t* up = j + 1 < rowCount_ ? row(z, j + 1) : nullptr;
+    std::uint32_t* xIds = ids.x.data() + std::size_t(j) * columns_;
+    std::uint32_t* yIds = ids.y.data() + std::size_t(j) * columns_;
+    const int y = j - 1;
+    for (int w = 0; w < words_ - 1; ++w) {
+      forEachBit((r[w] ^ nextBits(r, w)) & cubeMask_[w], w, [&](int b) {
+        const int x = b - kRowOffset;
+        xIds[x + 1] = addVertex(edgeSurfel({x, y, z}, 0, (r[w] >> (b & 63)) & 1));
+      });
+      if (up)
+        forEachBit((r[w] ^ up[w]) & voxelMask_[w], w, [&](int b) {
           const int x = b - kRowOffset;
-          xIds[x + 1] = addVertex(edgeSurfel({x, y, z}, 0, (r[w] >> (b & 63)) & 1));
-        });
-        if (up)
-          forEachBit((r[w] ^ up[w]) & voxelMask_[w], w, [&](int b) {
-            const int x = b - kRowOffset;
-            yIds[x + 1] = addVertex(edgeSurfel({x, y, z}, 1, (r[w] >> (b & 63)) & 1));
-          });
-      }
-    }
-  }
-
-  /// Vertex indices for the cut z-edges between planes z and z + 1.
-  void numberSlabEdges(int z) {
-    for (int j = 0; j < rowCount_; ++j) {
-      const std::uint64_t* lo = row(z, j);
-      const std::uint64_t* hi = row(z + 1, j);
-      std::uint32_t* zIds = zEdge_.data() + std::size_t(j) * columns_;
-      for (int w = 0; w < words_ - 1; ++w)
-        forEachBit((lo[w] ^ hi[w]) & voxelMask_[w], w, [&](int b) {
-          const int x = b - kRowOffset;
-          zIds[x + 1] = addVertex(edgeSurfel({x, j - 1, z}, 2, (lo[w] >> (b & 63)) & 1));
+          yIds[x + 1] = addVertex(edgeSurfel({x, y, z}, 1, (r[w] >> (b & 63)) & 1));
         });
     }
   }
 
-  /// Emits the triangles of every non-trivial cube of the slab between planes z and z + 1.
-  void marchSlab(int z) {
-    for (int j = 0; j + 1 < rowCount_; ++j) {
-      // Corner rows: rc holds the corners with y-bit c & 1 and z-bit c >> 1.
-      const std::uint64_t* r0 = row(z, j);
-      const std::uint64_t* r1 = row(z, j + 1);
-      const std::uint64_t* r2 = row(z + 1, j);
-      const std::uint64_t* r3 = row(z + 1, j + 1);
-      // Vertex-index rows of the 12 cube edges (DigitalCube.h), to be read at column i = x + 1.
-      const std::size_t at = std::size_t(j) * columns_, above = at + columns_;
-      const std::array<const std::uint32_t*, 12> edge = {
-          bottom_.x.data() + at, bottom_.x.data() + above,  // x-edges: y-bit, z-bit
-          top_.x.data() + at,    top_.x.data() + above,
-          bottom_.y.data() + at, bottom_.y.data() + at + 1,  // y-edges: x-bit, z-bit
-          top_.y.data() + at,    top_.y.data() + at + 1,
-          zEdge_.data() + at,    zEdge_.data() + at + 1,     // z-edges: x-bit, y-bit
-          zEdge_.data() + above, zEdge_.data() + above + 1};
-      for (int w = 0; w < words_ - 1; ++w)
-        forEachBit(mixedCubes(r0, r1, r2, r3, w) & cubeMask_[w], w, [&](int b) {
-          const unsigned config =
-              twoBits(r0, b) | (twoBits(r1, b) << 2) | (twoBits(r2, b) << 4) | (twoBits(r3, b) << 6);
-          const int i = b - kRowOffset + 1;
-          for (const auto& t : table_[config]->allTriangles())
-            mesh_.triangles.push_back({edge[t[0]][i], edge[t[1]][i], edge[t[2]][i]});
-        });
-    }
+  /// Vertex indices for the cut z-edges of row j between planes z and z + 1.
+  void numberSlabEdges(int z, int j) {
+    const std::uint64_t* lo = row(z, j);
+    const std::uint64_t* hi = row(z + 1, j);
+    std::uint32_t* zIds = zEdge_.data() + std::size_t(j & 1) * columns_;
+    for (int w = 0; w < words_ - 1; ++w)
+      forEachBit((lo[w] ^ hi[w]) & voxelMask_[w], w, [&](int b) {
+        const int x = b - kRowOffset;
+        zIds[x + 1] = addVertex(edgeSurfel({x, j - 1, z}, 2, (lo[w] >> (b & 63)) & 1));
+      });
+  }
+
+  /// Emits the triangles of every non-trivial cube with min corner y = j - 1 in the slab
+  /// between planes z and z + 1.
+  void marchRow(int z, int j) {
+    // Corner rows: rc holds the corners with y-bit c & 1 and z-bit c >> 1.
+    const std::uint64_t* r0 = row(z, j);
+    const std::uint64_t* r1 = row(z, j + 1);
+    const std::uint64_t* r2 = row(z + 1, j);
+    const std::uint64_t* r3 = row(z + 1, j + 1);
+    // Vertex-index rows of the 12 cube edges (DigitalCube.h), to be read at column i = x + 1.
+    const std::size_t at = std::size_t(j) * columns_, above = at + columns_;
+    const std::size_t zAt = std::size_t(j & 1) * columns_, zAbove = std::size_t((j + 1) & 1) * columns_;
+    const std::array<const std::uint32_t*, 12> edge = {
+        bottom_.x.data() + at, bottom_.x.data() + above,  // x-edges: y-bit, z-bit
+        top_.x.data() + at,    top_.x.data() + above,
+        bottom_.y.data() + at, bottom_.y.data() + at + 1,  // y-edges: x-bit, z-bit
+        top_.y.data() + at,    top_.y.data() + at + 1,
+        zEdge_.data() + zAt,    zEdge_.data() + zAt + 1,     // z-edges: x-bit, y-bit
+        zEdge_.data() + zAbove, zEdge_.data() + zAbove + 1};
+    for (int w = 0; w < words_ - 1; ++w)
+      forEachBit(mixedCubes(r0, r1, r2, r3, w) & cubeMask_[w], w, [&](int b) {
+        const unsigned config =
+            twoBits(r0, b) | (twoBits(r1, b) << 2) | (twoBits(r2, b) << 4) | (twoBits(r3, b) << 6);
+        const int i = b - kRowOffset + 1;
+        for (const auto& t : table_[config]->allTriangles())
+          mesh_.triangles.push_back({edge[t[0]][i], edge[t[1]][i], edge[t[2]][i]});
+      });
   }
 
   Dims dims_;
@@ -223,7 +226,7 @@ class Scanner {
   std::vector<std::uint64_t> cubeMask_, voxelMask_;
   std::vector<std::uint64_t> bits_;  // planes z = -1 .. nz of rowCount_ rows of words_ words
   PlaneEdges bottom_, top_;          // planes z and z + 1 of the current slab
-  std::vector<std::uint32_t> zEdge_;
+  std::vector<std::uint32_t> zEdge_;  // z-edges of the slab, rows j and j + 1 at j & 1
   TriangleMesh mesh_;
 };
 

@@ -6,9 +6,9 @@
 // How it works (see ScanIsoSurface.cpp):
 //  - The image is read once, one row of voxels at a time, into bit sets (64 voxels a word; one
 //    bit per voxel of the domain padded by one voxel, 1/8 of a uint8 image). The surfels are
-//    counted (popcounts) so that the mesh is allocated once. The cubes of a row whose 8 corners
-//    are all equal (configurations 0x00 and 0xFF, the vast majority) are skipped by a few word
-//    operations per 64 cubes.
+//    counted (popcounts) so that the mesh is allocated up front. The cubes of a row whose 8
+//    corners are all equal (configurations 0x00 and 0xFF, the vast majority) are skipped by a
+//    few word operations per 64 cubes.
 //  - Vertices are shared between cubes without a global hash map (as in flying edges and
 //    OpenVDB's VolumeToMesh): before the cubes of a slab z..z+1 are visited, every cut grid edge
 //    of the slab gets its vertex index in small per-plane arrays indexed by edge position.

@@ -9,6 +9,7 @@ packages=(
   libopenmesh-dev                # OpenMesh: half-edge meshes and mesh IO
   libgtest-dev                   # GoogleTest
   libinsighttoolkit5-dev         # ITK: NIfTI / NRRD / MetaImage / DICOM volumes for the CLI
+  libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip size checks)
   gnuplot-nox                    # plots of the Figure 9 benchmark
   mricron-data                   # real MRI volumes used by the demo and one test
 )

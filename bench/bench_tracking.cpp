@@ -1,0 +1,156 @@
+// Tracking throughput (issue 2): surfels per second of trackComponent, single thread, on the
+// noisy spheres of the Figure 9 protocol (spec.md §7), and on an implicit ball of radius 900 in
+// a 4096^3 domain that can be neither stored nor scanned. Memory is the tracker's own peak:
+// each case runs in a child process that reports its peak resident size minus its size just
+// before tracking (so the stored image does not count).
+//
+//   bench_tracking [--sizes 64,128,...] [--quick] [--reps N] [--pair 26-6]
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "FindSeed.h"
+#include "SphereImage.h"
+#include "TrackComponent.h"
+
+using namespace surftrack;
+
+namespace {
+
+double threadSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+long residentKiB() {
+  std::ifstream statm("/proc/self/statm");
+  long pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+struct Measurement {
+  std::size_t surfels = 0;
+  double wallSeconds = 0, cpuSeconds = 0;  // medians
+  long peakKiB = 0;                        // tracker's peak memory
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// Runs `track` `reps` times in a child process; the child sends back its figures on a pipe.
+template <class Track>
+Measurement measure(int reps, const Track& track) {
+  int fds[2];
+  if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    const long before = residentKiB();
+    std::vector<double> wall, cpu;
+    std::size_t surfels = 0;
+    for (int r = 0; r < reps; ++r) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const double c0 = threadSeconds();
+      surfels = track();
+      cpu.push_back(threadSeconds() - c0);
+      wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    Measurement m{surfels, median(wall), median(cpu), usage.ru_maxrss - before};
+    if (write(fds[1], &m, sizeof m) != sizeof m) _exit(1);
+    _exit(0);
+  }
+  close(fds[1]);
+  Measurement m{};
+  const bool ok = read(fds[0], &m, sizeof m) == sizeof m;
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (!ok || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw std::runtime_error("measurement child failed");
+  return m;
+}
+
+std::vector<int> parseList(const std::string& text) {
+  std::vector<int> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stoi(item));
+  return out;
+}
+
+void printRow(const std::string& name, const Measurement& m) {
+  std::printf("%-28s %12zu %10.1f %10.1f %9.2f %9.2f %10.1f %8.0f\n", name.c_str(), m.surfels,
+              1e3 * m.wallSeconds, 1e3 * m.cpuSeconds, m.surfels / m.wallSeconds / 1e6,
+              m.surfels / m.cpuSeconds / 1e6, m.peakKiB / 1024.0,
+              m.surfels ? 1024.0 * m.peakKiB / double(m.surfels) : 0.0);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    std::vector<int> sizes{64, 128, 256, 512, 1024};
+    int reps = 5;
+    AdjacencyPair pair = AdjacencyPair::k26_6;
+    bool implicitBall = true;
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+        return argv[++i];
+      };
+      if (a == "--sizes") sizes = parseList(value());
+      else if (a == "--quick") sizes = {64, 128, 256}, reps = 3, implicitBall = false;
+      else if (a == "--reps") reps = std::stoi(value());
+      else if (a == "--pair") pair = parseAdjacencyPair(value());
+      else throw std::invalid_argument("unknown option " + a);
+    }
+    std::printf("trackComponent throughput, pair %s, median of %d runs, one thread\n",
+                toString(pair).c_str(), reps);
+    std::printf("%-28s %12s %10s %10s %9s %9s %10s %8s\n", "case", "surfels", "wall ms",
+                "cpu ms", "M/s wall", "M/s cpu", "peak MiB", "B/surfel");
+    for (int q : sizes)
+      for (double noise : {0.0, 0.01, 0.05}) {
+        const bench::NoisySphere sphere = bench::makeNoisySphere(q, noise);
+        const auto image = sphere.binary();
+        const Surfel seed = bench::protocolSeed(sphere);
+        const Measurement m = measure(q >= 512 ? std::min(reps, 3) : reps, [&] {
+          return trackComponent(image, seed, pair).surfelCount();
+        });
+        printRow("sphere q=" + std::to_string(q) + " p=" + std::to_string(int(noise * 100)) + "%", m);
+      }
+    if (implicitBall) {
+      const int c = 2048, radius = 900;
+      const std::int64_t r2 = std::int64_t(radius) * radius;
+      const ImplicitImage ball({4096, 4096, 4096}, [&](int x, int y, int z) {
+        const std::int64_t dx = x - c, dy = y - c, dz = z - c;
+        return dx * dx + dy * dy + dz * dz <= r2;
+      });
+      const Surfel seed = *seedAlongRay(ball, Voxel{c, c, c}, 0);
+      printRow("implicit ball R=900 in 4096^3", measure(std::min(reps, 3), [&] {
+                 return trackComponent(ball, seed, pair).surfelCount();
+               }));
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "bench_tracking: error: " << e.what() << "\n";
+    return 1;
+  }
+}

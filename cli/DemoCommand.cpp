@@ -1,0 +1,192 @@
+// `surftrack demo`: the README's main job in one command. Builds the phantom, tracks its seed's
+// surface, writes the mesh and prints the summary; with mricron-data installed, does the same
+// for the cortex of a real MRI volume and one region of an atlas.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "Commands.h"
+#include "Extraction.h"
+#include "OutputFile.h"
+#include "Phantom.h"
+#include "Report.h"
+
+namespace surftrack::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The cortical surface of ch2better.nii.gz (the Colin27 T1 MRI, skull-stripped, uint8,
+/// 0.5 mm voxels). Its histogram ('surftrack info') has the background at 0-1 and, inside the
+/// brain (51-130), a gray-matter peak at 86 and a white-matter peak at 115 with a shallow
+/// valley between them; iso-value 100, about halfway, gives the gray/white-matter interface of
+/// the cortex (the "white" surface). The largest boundary is the cerebral one.
+constexpr double kCortexIso = 100;
+/// The AAL atlas region extracted: label 1, the left precentral gyrus (aal.nii.txt).
+constexpr int kAtlasLabel = 1;
+
+/// The name of a label in the atlas's text file ("1 Precentral_L 2001"), or "label N".
+std::string atlasLabelName(const fs::path& atlas, int label) {
+  fs::path txt = atlas;
+  txt.replace_extension();  // aal.nii.gz -> aal.nii
+  txt += ".txt";
+  std::ifstream in(txt);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    int value;
+    std::string name;
+    if (fields >> value >> name && value == label) return name;
+  }
+  return "label" + std::to_string(label);
+}
+
+struct DemoPart {
+  std::string title;
+  std::string input;      ///< file name, or the phantom's description
+  std::string output;     ///< file in the demo directory
+  std::string command;    ///< the equivalent `surftrack mesh` command line
+};
+
+struct DemoRun {
+  DemoPart part;
+  Extraction extraction;
+};
+
+Extraction extract(const io::AnyVolume& volume, const std::string& inputName, const SurfaceOptions& options,
+                   const std::string& output, const OutputOptions& out, double readSeconds) {
+  Extraction x;
+  x.output = output;
+  x.format = meshFormat(output);
+  x.binary = true;
+  requireWritable(output);
+  Progress progress(Progress::wanted(out.quiet));
+  StageClock clock;
+  x.timings.push_back({"read", readSeconds});
+  describeInput(volume, inputName, x);
+  const int stages = 5;
+  extractSurface(volume, options, x, clock, progress, 0, stages);
+  progress.stage(stages - 1, stages, "writing " + output);
+  x.bytes = writeMeshFile(x.mesh, output, x.binary);
+  clock.lap(x.timings, "write");
+  x.totalSeconds = clock.total() + readSeconds;
+  progress.finish();
+  return x;
+}
+
+std::string quoteArg(const std::string& s) {
+  if (s.find_first_of(" '\"$\\") == std::string::npos) return s;
+  std::string out = "'";
+  for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return out + "'";
+}
+
+}  // namespace
+
+int runDemo(const std::vector<std::string>& args) {
+  const DemoOptions o = parseDemoOptions(args);
+  std::error_code ec;
+  fs::create_directories(o.outputDir, ec);
+  if (ec || !fs::is_directory(o.outputDir))
+    throw std::runtime_error("cannot create the demo directory '" + o.outputDir + "'" +
+                             (ec ? ": " + ec.message() : ""));
+  const fs::path dir(o.outputDir);
+  std::vector<DemoRun> runs;
+  std::vector<std::string> notes;
+
+  // 1. The phantom.
+  {
+    StageClock clock;
+    const Phantom phantom = makePhantom(o.size, o.noise);
+    const std::string volumePath = (dir / "phantom.nrrd").string();
+    io::writeVolume(io::AnyVolume(phantom.image), volumePath);
+    const double buildSeconds = clock.total();
+    SurfaceOptions s;
+    s.iso = phantom.iso;
+    s.seedMode = SeedMode::Surfel;
+    s.seedVoxel = phantom.seed.inside();
+    s.seedDirection = phantom.seed.n;
+    const std::string mesh = (dir / "phantom.ply").string();
+    std::ostringstream name;
+    name << "phantom " << o.size << "^3, sphere minus 3 cylinders, " << o.noise * 100 << " % noise (" << volumePath << ")";
+    DemoRun run{{"phantom (Figure 6c: sphere minus cylinders, salt-and-pepper noise)", volumePath, mesh, ""}, extract(io::AnyVolume(phantom.image), name.str(), s, mesh, o.out, 0)};
+    run.extraction.timings.front() = {"build", buildSeconds};
+    run.extraction.totalSeconds += buildSeconds;
+    const Voxel c = phantom.seed.inside();
+    run.part.command = "surftrack mesh " + quoteArg(volumePath) + " -o " + quoteArg(mesh) + " --iso 127.5 --seed " +
+                       std::to_string(c.x) + "," + std::to_string(c.y) + "," + std::to_string(c.z) + ",+x";
+    runs.push_back(std::move(run));
+  }
+
+  // 2. and 3. The real MRI volumes of mricron-data.
+  const fs::path mricron(o.mricronDir);
+  const fs::path brain = mricron / "ch2better.nii.gz", atlas = mricron / "aal.nii.gz";
+  if (!o.realData) {
+    notes.push_back("--no-mricron: the MRI part was skipped");
+  } else if (!fs::exists(brain) || !fs::exists(atlas)) {
+    notes.push_back("mricron-data is not installed (no " + brain.string() +
+                    "): the MRI part was skipped; 'apt-get install mricron-data' adds it");
+  } else {
+    {
+      StageClock clock;
+      const io::AnyVolume volume = io::readVolume(brain.string());
+      const double readSeconds = clock.total();
+      SurfaceOptions s;
+      s.iso = kCortexIso;
+      s.seedMode = SeedMode::Largest;
+      const std::string mesh = (dir / "cortex.ply").string();
+      DemoRun run{{"cortex (gray/white-matter interface)", brain.string(), mesh, ""}, extract(volume, brain.string(), s, mesh, o.out, readSeconds)};
+      run.part.command = "surftrack mesh " + quoteArg(brain.string()) + " -o " + quoteArg(mesh) + " --iso " +
+                         std::to_string(int(kCortexIso)) + " --largest";
+      runs.push_back(std::move(run));
+    }
+    {
+      StageClock clock;
+      const io::AnyVolume volume = io::readVolume(atlas.string());
+      const double readSeconds = clock.total();
+      SurfaceOptions s;
+      s.label = kAtlasLabel;
+      s.seedMode = SeedMode::Largest;
+      const std::string name = atlasLabelName(atlas, kAtlasLabel);
+      const std::string mesh = (dir / ("aal-" + name + ".ply")).string();
+      DemoRun run{{"atlas region " + std::to_string(kAtlasLabel) + " (" + name + ")", atlas.string(), mesh, ""},
+                  extract(volume, atlas.string(), s, mesh, o.out, readSeconds)};
+      run.part.command = "surftrack mesh " + quoteArg(atlas.string()) + " -o " + quoteArg(mesh) + " --label " +
+                         std::to_string(kAtlasLabel) + " --largest";
+      runs.push_back(std::move(run));
+    }
+  }
+
+  if (o.out.json) {
+    JsonWriter json;
+    json.beginObject();
+    json.key("output_dir").value(o.outputDir);
+    json.key("results").beginArray();
+    for (const auto& r : runs) {
+      json.beginObject();
+      json.key("name").value(r.part.title);
+      json.key("command").value(r.part.command);
+      json.key("result");
+      writeJson(json, r.extraction);
+      json.endObject();
+    }
+    json.endArray();
+    json.key("notes").array(notes);
+    json.endObject();
+    std::cout << json.str() << std::endl;
+  } else if (!o.out.quiet) {
+    for (const auto& r : runs) {
+      std::cout << "== " << r.part.title << "\n";
+      printSummary(std::cout, r.extraction);
+      std::cout << "  same as   " << r.part.command << "\n\n";
+    }
+    for (const auto& n : notes) std::cout << "note: " << n << "\n";
+    std::cout << "demo: " << runs.size() << " mesh" << (runs.size() == 1 ? "" : "es") << " written to "
+              << o.outputDir << "/\n";
+  }
+  return 0;
+}
+
+}  // namespace surftrack::cli

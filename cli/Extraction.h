@@ -1,0 +1,99 @@
+// The tool's pipeline on a volume in memory: choose the 1-voxels (iso-value or label), resolve
+// the seed rule to a boundary surfel, track its kappa-lambda-boundary, convert it to a mesh
+// placed in physical coordinates — or scan every boundary (--all). Records what it did, for
+// the summary: the seed actually used, counts, timings per stage.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "MeshStats.h"
+#include "Options.h"
+#include "Progress.h"
+#include "ReadVolume.h"
+#include "SurfaceMesh.h"
+
+namespace surftrack::cli {
+
+struct StageTiming {
+  std::string name;
+  double seconds = 0;
+};
+
+/// Measures stages one after the other.
+class StageClock {
+ public:
+  StageClock() : last_(std::chrono::steady_clock::now()), start_(last_) {}
+  /// Ends the running stage, records it as `name`.
+  void lap(std::vector<StageTiming>& out, const std::string& name) {
+    const auto now = std::chrono::steady_clock::now();
+    out.push_back({name, std::chrono::duration<double>(now - last_).count()});
+    last_ = now;
+  }
+  double total() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_, start_;
+};
+
+/// Everything the summary reports about one extraction.
+struct Extraction {
+  // The input.
+  std::string input;
+  Dims dims;
+  io::ScalarType type = io::ScalarType::UInt8;
+  ImageGeometry geometry;
+  double dataMin = 0, dataMax = 0;
+
+  // The binary image and the surface options.
+  bool byLabel = false;
+  double value = 0;               ///< the iso-value or the label
+  bool valueFromOtsu = false;     ///< no --iso / --label: Otsu's threshold was used
+  std::size_t insideVoxels = 0;   ///< 1-voxels in the domain
+  AdjacencyPair pair = AdjacencyPair::k26_6;
+  std::string mapping;            ///< "linear" or "midpoint"
+
+  // The seed.
+  SeedMode seedMode = SeedMode::Largest;
+  std::optional<std::array<double, 3>> seedPoint;  ///< --seed-point, physical
+  std::optional<Voxel> seedVoxel;                  ///< --seed, or the voxel of --seed-point
+  bool seedVoxelInside = false;                    ///< the seed voxel is a 1-voxel
+  std::optional<Direction> walkDirection;          ///< the ray that found the surfel
+  int walkSteps = 0;                               ///< voxels walked along it
+  std::optional<Surfel> seedSurfel;                ///< the surfel tracking started from
+  std::size_t boundaries = 0;                      ///< --largest / --all: boundaries in the image
+
+  // The result.
+  std::size_t surfels = 0;
+  SurfaceMesh mesh;
+  MeshStats stats;
+  std::vector<StageTiming> timings;
+  double totalSeconds = 0;
+
+  // The output file.
+  std::string output;
+  std::string format;  ///< "ply", "obj", "off", "stl"
+  bool binary = false;
+  std::uintmax_t bytes = 0;
+};
+
+/// Runs the pipeline on `volume` (already read; `extraction` holds the input fields and the
+/// "read" timing) up to the mesh and its statistics. Throws std::runtime_error with a one-line
+/// message for an iso-value outside the data range, a label absent from the image, a seed
+/// outside the domain or on no boundary, an empty selection.
+void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& options,
+                    Extraction& extraction, StageClock& clock, Progress& progress,
+                    int stageOffset, int stageCount);
+
+/// Fills the input fields of `extraction` from `volume`.
+void describeInput(const io::AnyVolume& volume, const std::string& path, Extraction& extraction);
+
+/// Reads the volume of `input` (ITK or raw) and applies the geometry overrides.
+io::AnyVolume readInput(const InputOptions& input);
+
+}  // namespace surftrack::cli

@@ -1,0 +1,45 @@
+// `surftrack mesh INPUT -o OUTPUT [options]`.
+#include <iostream>
+
+#include "Commands.h"
+#include "Extraction.h"
+#include "OutputFile.h"
+#include "Report.h"
+
+namespace surftrack::cli {
+
+int runMesh(const std::vector<std::string>& args) {
+  const MeshOptions o = parseMeshOptions(args);
+  Extraction x;
+  x.output = o.output;
+  x.format = meshFormat(o.output);  // a usage error, before any work
+  x.binary = !o.ascii && (x.format == "ply" || x.format == "stl");
+  requireWritable(o.output);        // fail now rather than after the work
+
+  Progress progress(Progress::wanted(o.out.quiet));
+  StageClock clock;
+  const int stages = o.surface.seedMode == SeedMode::All ? 5 : 6;
+  progress.stage(0, stages, "reading " + o.input.path);
+  const io::AnyVolume volume = readInput(o.input);
+  clock.lap(x.timings, "read");
+  describeInput(volume, o.input.path, x);
+
+  extractSurface(volume, o.surface, x, clock, progress, 1, stages);
+
+  progress.stage(stages - 1, stages, "writing " + o.output);
+  x.bytes = writeMeshFile(x.mesh, o.output, x.binary);
+  clock.lap(x.timings, "write");
+  x.totalSeconds = clock.total();
+  progress.finish();
+
+  if (o.out.json) {
+    JsonWriter json;
+    writeJson(json, x);
+    std::cout << json.str() << std::endl;
+  } else if (!o.out.quiet) {
+    printSummary(std::cout, x);
+  }
+  return 0;
+}
+
+}  // namespace surftrack::cli

@@ -1,0 +1,93 @@
+// Command-line arguments of the `surftrack` tool: what each subcommand accepts, parsed into
+// plain structs. Any malformed command line throws UsageError (exit status 2).
+#pragma once
+
+#include <array>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "AdjacencyPair.h"
+#include "ReadVolume.h"
+#include "Surfel.h"
+
+namespace surftrack::cli {
+
+/// A malformed command line: the tool prints the message and exits with status 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// --help: main prints `text` on stdout and exits with status 0.
+struct HelpRequested {
+  std::string text;
+};
+
+/// How to read the input volume: with ITK, or as a raw file of a stated layout; optional
+/// overrides of the geometry.
+struct InputOptions {
+  std::string path;
+  bool raw = false;              ///< --raw-dims given: read a headerless raw file
+  io::RawLayout rawLayout;       ///< --raw-dims, --raw-type, --raw-endian, --raw-header
+  std::optional<std::array<double, 3>> spacing;  ///< --spacing
+  std::optional<std::array<double, 3>> origin;   ///< --origin
+};
+
+enum class SeedMode { Largest, All, Voxel, Surfel, Point };
+enum class MappingMode { Default, Midpoint, Linear };
+
+/// What surface to extract: a threshold or a label, a seed rule, a pair, a mapping.
+struct SurfaceOptions {
+  std::optional<double> iso;     ///< --iso S: 1-voxels are f > S
+  std::optional<double> label;   ///< --label L: 1-voxels are f = L
+  SeedMode seedMode = SeedMode::Largest;
+  Voxel seedVoxel;               ///< --seed x,y,z (SeedMode::Voxel) or the c of --seed x,y,z,DIR
+  Direction seedDirection = 0;   ///< the DIR of --seed x,y,z,DIR (SeedMode::Surfel)
+  std::array<double, 3> seedPoint{};  ///< --seed-point X,Y,Z (physical coordinates)
+  AdjacencyPair pair = AdjacencyPair::k26_6;
+  MappingMode mapping = MappingMode::Default;
+};
+
+struct OutputOptions {
+  bool json = false;   ///< --json: a JSON object on stdout instead of the summary
+  bool quiet = false;  ///< --quiet: nothing on stdout or stderr but errors
+};
+
+struct MeshOptions {
+  InputOptions input;
+  SurfaceOptions surface;
+  std::string output;   ///< -o: .ply, .obj, .off or .stl
+  bool ascii = false;   ///< --ascii: text PLY / STL
+  OutputOptions out;
+};
+
+struct InfoOptions {
+  InputOptions input;
+  OutputOptions out;
+};
+
+struct DemoOptions {
+  std::string outputDir = "surftrack-demo";  ///< -o DIR
+  int size = 128;                            ///< --size Q: phantom side
+  double noise = 0.01;                       ///< --noise P: salt-and-pepper probability
+  bool realData = true;                      ///< --no-mricron turns the MRI part off
+  std::string mricronDir = "/usr/share/mricron/templates";  ///< --mricron-dir
+  OutputOptions out;
+};
+
+MeshOptions parseMeshOptions(const std::vector<std::string>& args);
+InfoOptions parseInfoOptions(const std::vector<std::string>& args);
+DemoOptions parseDemoOptions(const std::vector<std::string>& args);
+
+/// "+x", "-x", "+y", "-y", "+z", "-z".
+std::string directionName(Direction d);
+
+/// The help texts.
+std::string mainUsage();
+std::string meshUsage();
+std::string infoUsage();
+std::string demoUsage();
+
+}  // namespace surftrack::cli

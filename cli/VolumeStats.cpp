@@ -1,0 +1,140 @@
+#include "VolumeStats.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <type_traits>
+
+namespace surftrack::cli {
+
+namespace {
+
+constexpr int kBins = 256;
+
+template <class T>
+VolumeStats statsOf(const DenseImage<T>& image) {
+  VolumeStats s;
+  s.integral = std::is_integral_v<T>;
+  const auto& data = image.data();
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0;
+  for (T v : data) {
+    const double d = double(v);
+    if (!std::isfinite(d)) {
+      ++s.nonFinite;
+      continue;
+    }
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+    sum += d;
+  }
+  s.voxels = data.size() - s.nonFinite;
+  if (s.voxels == 0) {
+    s.histogram.assign(kBins, 0);
+    return s;
+  }
+  s.min = lo;
+  s.max = hi;
+  s.mean = sum / double(s.voxels);
+  // Integer data with a range of at most 256 values: one bin per value.
+  if (s.integral && hi - lo < kBins) s.binWidth = 1;
+  else s.binWidth = hi > lo ? (hi - lo) / kBins : 1;
+  s.histogram.assign(kBins, 0);
+  // Integer data over a range of at most 2^20 values: count every value (a direct array, not a
+  // map: this runs over every voxel), then list them as labels when there are at most 256.
+  const bool countValues = s.integral && hi - lo < double(1 << 20);
+  std::vector<std::size_t> valueCount(countValues ? std::size_t(hi - lo) + 1 : 0, 0);
+  for (T v : data) {
+    const double d = double(v);
+    if (!std::isfinite(d)) continue;
+    if (countValues) {
+      ++valueCount[std::size_t(d - lo)];
+    } else {
+      const int b = int((d - lo) / s.binWidth);
+      s.histogram[std::clamp(b, 0, kBins - 1)]++;
+    }
+  }
+  if (countValues) {
+    std::size_t distinct = 0;
+    for (std::size_t i = 0; i < valueCount.size(); ++i) {
+      if (!valueCount[i]) continue;
+      ++distinct;
+      const int b = int(double(i) / s.binWidth);
+      s.histogram[std::clamp(b, 0, kBins - 1)] += valueCount[i];
+    }
+    if (distinct <= 256)
+      for (std::size_t i = 0; i < valueCount.size(); ++i)
+        if (valueCount[i]) s.labels.emplace_back(std::int64_t(lo) + std::int64_t(i), valueCount[i]);
+  }
+
+  // Otsu: the split between bins k and k + 1 maximising the between-class variance.
+  double total = 0, totalSum = 0;
+  for (int b = 0; b < kBins; ++b) {
+    total += double(s.histogram[b]);
+    totalSum += double(s.histogram[b]) * b;
+  }
+  // Equal maxima (empty bins between two classes: a 0/255 image) give a range of splits; take
+  // its middle, so that the threshold sits halfway between the classes.
+  std::vector<double> between(kBins - 1, -1);
+  double w0 = 0, sum0 = 0, best = -1;
+  for (int k = 0; k < kBins - 1; ++k) {
+    w0 += double(s.histogram[k]);
+    sum0 += double(s.histogram[k]) * k;
+    const double w1 = total - w0;
+    if (w0 == 0 || w1 == 0) continue;
+    const double m0 = sum0 / w0, m1 = (totalSum - sum0) / w1;
+    between[k] = w0 * w1 * (m0 - m1) * (m0 - m1);
+    best = std::max(best, between[k]);
+  }
+  int first = -1, last = 0;
+  for (int k = 0; k < kBins - 1; ++k)
+    if (between[k] >= 0 && between[k] >= best * (1 - 1e-12)) {
+      if (first < 0) first = k;
+      last = k;
+    }
+  const int bestK = first < 0 ? 0 : (first + last) / 2;
+  // Class 0 is bins [0, bestK]; the iso-value is the top of bin bestK. With one bin per
+  // integer value, class 0 is the values <= lo + bestK, and s = lo + bestK + 0.5 sits halfway.
+  if (s.integral && s.binWidth == 1) s.otsu = lo + bestK + 0.5;
+  else s.otsu = lo + (bestK + 1) * s.binWidth;
+  if (hi > lo) s.otsu = std::clamp(s.otsu, lo, std::nextafter(hi, lo));
+  else s.otsu = lo;
+  return s;
+}
+
+}  // namespace
+
+double VolumeStats::quantile(double q) const {
+  const double target = q * double(voxels);
+  double seen = 0;
+  for (int b = 0; b < int(histogram.size()); ++b) {
+    seen += double(histogram[b]);
+    if (seen >= target) return std::min(max, min + (b + 1) * binWidth);
+  }
+  return max;
+}
+
+VolumeStats computeStats(const io::AnyVolume& volume) {
+  return std::visit([](const auto& image) { return statsOf(image); }, volume);
+}
+
+std::size_t countAbove(const io::AnyVolume& volume, double s) {
+  return std::visit(
+      [s](const auto& image) {
+        std::size_t n = 0;
+        for (auto v : image.data()) n += double(v) > s;
+        return n;
+      },
+      volume);
+}
+
+std::size_t countEqual(const io::AnyVolume& volume, double label) {
+  return std::visit(
+      [label](const auto& image) {
+        std::size_t n = 0;
+        for (auto v : image.data()) n += double(v) == label;
+        return n;
+      },
+      volume);
+}
+
+}  // namespace surftrack::cli

@@ -1,0 +1,486 @@
+// The ITK half of io/: the only translation unit of the project that includes ITK headers.
+#include "ReadVolume.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+#include <gdcmTrace.h>
+#include <gdcmUIDGenerator.h>
+#include <itkGDCMImageIO.h>
+#include <itkGDCMImageIOFactory.h>
+#include <itkGDCMSeriesFileNames.h>
+#include <itkImage.h>
+#include <itkImageFileReader.h>
+#include <itkImageFileWriter.h>
+#include <itkImageIOFactory.h>
+#include <itkImageSeriesReader.h>
+#include <itkImageSeriesWriter.h>
+#include <itkMetaDataObject.h>
+#include <itkMetaImageIOFactory.h>
+#include <itkNiftiImageIOFactory.h>
+#include <itkNrrdImageIOFactory.h>
+#include <itkTIFFImageIOFactory.h>
+#include <itkVTKImageIOFactory.h>
+#include <zlib.h>
+
+namespace surftrack::io {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Registers the ImageIO factories once. Registering them by hand, instead of through the
+/// ITK_IO_FACTORY_REGISTER_MANAGER machinery of ${ITK_USE_FILE}, keeps ITK out of every other
+/// target's compile flags.
+void registerFactories() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    itk::Object::GlobalWarningDisplayOff();  // ITK warnings are multi-line noise on stderr
+    gdcm::Trace::WarningOff();                // and so are GDCM's (DICOM)
+    gdcm::Trace::ErrorOff();
+    gdcm::Trace::DebugOff();
+    itk::NiftiImageIOFactory::RegisterOneFactory();
+    itk::NrrdImageIOFactory::RegisterOneFactory();
+    itk::MetaImageIOFactory::RegisterOneFactory();
+    itk::GDCMImageIOFactory::RegisterOneFactory();
+    itk::TIFFImageIOFactory::RegisterOneFactory();
+    itk::VTKImageIOFactory::RegisterOneFactory();
+  });
+}
+
+/// An ITK exception's description on one line.
+std::string oneLine(const itk::ExceptionObject& e) {
+  std::string text = e.GetDescription() ? e.GetDescription() : "";
+  std::string out;
+  bool space = false;
+  for (char ch : text) {
+    if (ch == '\n' || ch == '\r' || ch == '\t' || ch == ' ') {
+      space = !out.empty();
+      continue;
+    }
+    if (space) out += ' ';
+    space = false;
+    out += ch;
+  }
+  return out.empty() ? "ITK error" : out;
+}
+
+std::string componentName(itk::IOComponentEnum c) {
+  return itk::ImageIOBase::GetComponentTypeAsString(c);
+}
+
+std::optional<ScalarType> scalarTypeOf(itk::IOComponentEnum c) {
+  using C = itk::IOComponentEnum;
+  switch (c) {
+    case C::UCHAR: return ScalarType::UInt8;
+    case C::SHORT: return ScalarType::Int16;
+    case C::USHORT: return ScalarType::UInt16;
+    case C::INT: return ScalarType::Int32;
+    case C::FLOAT: return ScalarType::Float32;
+    case C::DOUBLE: return ScalarType::Float64;
+    default: return std::nullopt;
+  }
+}
+
+/// Copies an ITK image into a DenseImage with its geometry.
+template <class T>
+AnyVolume toDense(const itk::Image<T, 3>* image, const std::string& path) {
+  const auto region = image->GetLargestPossibleRegion();
+  const auto size = region.GetSize();
+  Dims dims{int(size[0]), int(size[1]), int(size[2])};
+  if (dims.empty()) throw ReadError("cannot read '" + path + "': the image is empty");
+  ImageGeometry geometry;
+  for (int a = 0; a < 3; ++a) {
+    geometry.spacing[a] = image->GetSpacing()[a];
+    geometry.origin[a] = image->GetOrigin()[a];
+    for (int b = 0; b < 3; ++b) geometry.direction[a][b] = image->GetDirection()(a, b);
+    if (!(geometry.spacing[a] > 0) || !std::isfinite(geometry.spacing[a]))
+      throw ReadError("cannot read '" + path + "': its voxel spacing is not positive");
+  }
+  DenseImage<T> out(dims, T{}, geometry);
+  const T* buffer = image->GetBufferPointer();
+  std::copy(buffer, buffer + dims.count(), out.data().begin());
+  return AnyVolume(std::move(out));
+}
+
+template <class T>
+AnyVolume readFileAs(itk::ImageIOBase* imageIO, const std::string& path) {
+  using Image = itk::Image<T, 3>;
+  auto reader = itk::ImageFileReader<Image>::New();
+  reader->SetFileName(path);
+  reader->SetImageIO(imageIO);
+  reader->Update();
+  return toDense<T>(reader->GetOutput(), path);
+}
+
+template <class T>
+AnyVolume readSeriesAs(const std::vector<std::string>& files, const std::string& path) {
+  using Image = itk::Image<T, 3>;
+  auto reader = itk::ImageSeriesReader<Image>::New();
+  auto dicom = itk::GDCMImageIO::New();
+  reader->SetImageIO(dicom);
+  reader->SetFileNames(files);
+  reader->Update();
+  return toDense<T>(reader->GetOutput(), path);
+}
+
+std::string unsupportedType(const std::string& path, const std::string& what) {
+  return "unsupported voxel type " + what + " in '" + path +
+         "': supported are uint8, int16, uint16, int32, float and double";
+}
+
+AnyVolume readDicomDirectory(const std::string& path) {
+  auto names = itk::GDCMSeriesFileNames::New();
+  names->SetUseSeriesDetails(true);
+  names->SetDirectory(path);
+  const auto& uids = names->GetSeriesUIDs();
+  if (uids.empty()) throw ReadError("cannot read '" + path + "': no DICOM series in this directory");
+  const std::vector<std::string> files = names->GetFileNames(uids.front());
+  if (files.empty()) throw ReadError("cannot read '" + path + "': empty DICOM series");
+  auto dicom = itk::GDCMImageIO::New();
+  dicom->SetFileName(files.front());
+  dicom->ReadImageInformation();
+  if (dicom->GetNumberOfComponents() != 1)
+    throw ReadError(unsupportedType(path, "with " + std::to_string(dicom->GetNumberOfComponents()) +
+                                              " components per voxel"));
+  const auto type = scalarTypeOf(dicom->GetComponentType());
+  if (!type) throw ReadError(unsupportedType(path, "'" + componentName(dicom->GetComponentType()) + "'"));
+  switch (*type) {
+    case ScalarType::UInt8: return readSeriesAs<std::uint8_t>(files, path);
+    case ScalarType::Int16: return readSeriesAs<std::int16_t>(files, path);
+    case ScalarType::UInt16: return readSeriesAs<std::uint16_t>(files, path);
+    case ScalarType::Int32: return readSeriesAs<std::int32_t>(files, path);
+    case ScalarType::Float32: return readSeriesAs<float>(files, path);
+    case ScalarType::Float64: return readSeriesAs<double>(files, path);
+  }
+  throw ReadError("unreachable");
+}
+
+std::string lowerName(const std::string& path) {
+  std::string name = fs::path(path).filename().string();
+  for (char& ch : name) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  return name;
+}
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+/// Bytes of a file after decompression (gzip is detected; other files are counted as they
+/// are), or -1 for a corrupt gzip stream. Reads the whole stream.
+std::int64_t decompressedSize(const std::string& path) {
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) return -1;
+  std::vector<char> buffer(1 << 20);
+  std::int64_t total = 0;
+  for (;;) {
+    const int n = gzread(f, buffer.data(), unsigned(buffer.size()));
+    if (n < 0) {
+      gzclose(f);
+      return -1;
+    }
+    if (n == 0) break;
+    total += n;
+  }
+  int error = 0;
+  gzerror(f, &error);
+  gzclose(f);
+  return error == Z_OK || error == Z_STREAM_END ? total : -1;
+}
+
+/// The size of a (possibly gzipped) file's content: the file size when it is not compressed.
+std::int64_t contentSize(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char magic[2] = {0, 0};
+  in.read(reinterpret_cast<char*>(magic), 2);
+  std::error_code ec;
+  if (!(magic[0] == 0x1f && magic[1] == 0x8b)) return std::int64_t(fs::file_size(path, ec));
+  return decompressedSize(path);
+}
+
+/// NIfTI (.nii, .nii.gz, .hdr/.img): ITK's reader fills a short data block with zeros without
+/// a word, so compare the data size with the header's vox_offset + voxel bytes.
+void requireCompleteNifti(const std::string& path, std::size_t dataBytes) {
+  const std::string name = lowerName(path);
+  std::string dataFile = path;
+  double offset = 0;
+  const bool single = endsWith(name, ".nii") || endsWith(name, ".nii.gz");
+  if (single) {
+    gzFile f = gzopen(path.c_str(), "rb");
+    unsigned char header[544] = {};
+    const int n = f ? gzread(f, header, sizeof header) : -1;
+    if (f) gzclose(f);
+    if (n < 348) throw ReadError("cannot read '" + path + "': the file is truncated (no complete NIfTI header)");
+    std::int32_t sizeofHdr;
+    std::memcpy(&sizeofHdr, header, 4);
+    const bool swapped = sizeofHdr != 348 && sizeofHdr != 540;
+    auto get = [&](std::size_t at, std::size_t bytes, void* out) {
+      unsigned char tmp[8];
+      std::memcpy(tmp, header + at, bytes);
+      if (swapped) std::reverse(tmp, tmp + bytes);
+      std::memcpy(out, tmp, bytes);
+    };
+    get(0, 4, &sizeofHdr);
+    if (sizeofHdr == 348) {
+      float voxOffset;
+      get(108, 4, &voxOffset);
+      offset = voxOffset;
+    } else if (sizeofHdr == 540) {
+      std::int64_t voxOffset;
+      get(168, 8, &voxOffset);
+      offset = double(voxOffset);
+    } else {
+      return;  // not a header we know: leave it to ITK
+    }
+  } else if (endsWith(name, ".hdr") || endsWith(name, ".hdr.gz")) {
+    dataFile = path.substr(0, path.size() - (endsWith(name, ".gz") ? 7 : 4)) + ".img";
+    std::error_code ec;
+    if (!fs::exists(dataFile, ec) && fs::exists(dataFile + ".gz", ec)) dataFile += ".gz";
+  } else {
+    return;
+  }
+  const std::int64_t size = contentSize(dataFile);
+  if (size < 0) throw ReadError("cannot read '" + path + "': corrupt compressed data");
+  if (double(size) < offset + double(dataBytes))
+    throw ReadError("cannot read '" + path + "': the file is truncated (" + std::to_string(size) +
+                    " bytes of data where the header announces " +
+                    std::to_string(std::int64_t(offset) + std::int64_t(dataBytes)) + ")");
+}
+
+/// A data file (.raw of a .mhd, data of a .nhdr) that is shorter than its header says is
+/// read by some ITK readers without complaint; check the size where it is cheap to know.
+void requireCompleteData(itk::ImageIOBase* imageIO, const std::string& path, std::size_t voxels) {
+  requireCompleteNifti(path, voxels * imageIO->GetComponentSize());
+  const std::string ext = fs::path(path).extension().string();
+  if (ext == ".mha" || ext == ".mhd") {
+    // MetaImage: read the header lines up to ElementDataFile.
+    std::ifstream in(path, std::ios::binary);
+    std::string line, dataFile;
+    bool compressed = false;
+    std::streamoff headerEnd = 0;
+    while (std::getline(in, line)) {
+      if (line.rfind("CompressedData", 0) == 0 && line.find("True") != std::string::npos)
+        compressed = true;
+      if (line.rfind("ElementDataFile", 0) == 0) {
+        auto eq = line.find('=');
+        dataFile = line.substr(eq == std::string::npos ? line.size() : eq + 1);
+        dataFile.erase(0, dataFile.find_first_not_of(" \t"));
+        while (!dataFile.empty() && (dataFile.back() == '\r' || dataFile.back() == ' '))
+          dataFile.pop_back();
+        headerEnd = in.tellg();
+        break;
+      }
+    }
+    if (compressed || dataFile.empty()) return;
+    const std::size_t bytes = voxels * imageIO->GetComponentSize();
+    std::error_code ec;
+    if (dataFile == "LOCAL") {
+      if (fs::file_size(path, ec) < std::uintmax_t(headerEnd) + bytes)
+        throw ReadError("cannot read '" + path + "': the file is truncated");
+    } else if (dataFile.find('%') == std::string::npos && dataFile != "LIST") {
+      const fs::path data = fs::path(path).parent_path() / dataFile;
+      if (!fs::exists(data, ec))
+        throw ReadError("cannot read '" + path + "': its data file '" + data.string() + "' is missing");
+      if (fs::file_size(data, ec) < bytes)
+        throw ReadError("cannot read '" + path + "': its data file '" + data.string() + "' is truncated");
+    }
+  }
+}
+
+}  // namespace
+
+AnyVolume readVolume(const std::string& path) {
+  registerFactories();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
+  try {
+    if (fs::is_directory(path, ec)) return readDicomDirectory(path);
+    {
+      std::ifstream probe(path, std::ios::binary);
+      if (!probe) throw ReadError("cannot open '" + path + "': " + std::strerror(errno));
+      if (fs::file_size(path, ec) == 0) throw ReadError("cannot read '" + path + "': the file is empty");
+    }
+    itk::ImageIOBase::Pointer imageIO =
+        itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::IOFileModeEnum::ReadMode);
+    if (!imageIO)
+      throw ReadError("cannot read '" + path +
+                      "': not a recognised image file (NIfTI, NRRD, MetaImage, DICOM, TIFF, VTK); "
+                      "for a raw file give --raw-dims and --raw-type");
+    imageIO->SetFileName(path);
+    imageIO->ReadImageInformation();
+    const unsigned dimension = imageIO->GetNumberOfDimensions();
+    std::size_t voxels = 1;
+    for (unsigned d = 0; d < dimension; ++d) {
+      voxels *= imageIO->GetDimensions(d);
+      if (d >= 3 && imageIO->GetDimensions(d) != 1)
+        throw ReadError("cannot read '" + path + "': a " + std::to_string(dimension) +
+                        "D image with more than one volume; give a 3D image");
+    }
+    if (imageIO->GetNumberOfComponents() != 1)
+      throw ReadError(unsupportedType(
+          path, "with " + std::to_string(imageIO->GetNumberOfComponents()) + " components per voxel"));
+    const auto type = scalarTypeOf(imageIO->GetComponentType());
+    if (!type)
+      throw ReadError(unsupportedType(path, "'" + componentName(imageIO->GetComponentType()) + "'"));
+    requireCompleteData(imageIO, path, voxels);
+    switch (*type) {
+      case ScalarType::UInt8: return readFileAs<std::uint8_t>(imageIO, path);
+      case ScalarType::Int16: return readFileAs<std::int16_t>(imageIO, path);
+      case ScalarType::UInt16: return readFileAs<std::uint16_t>(imageIO, path);
+      case ScalarType::Int32: return readFileAs<std::int32_t>(imageIO, path);
+      case ScalarType::Float32: return readFileAs<float>(imageIO, path);
+      case ScalarType::Float64: return readFileAs<double>(imageIO, path);
+    }
+    throw ReadError("unreachable");
+  } catch (const itk::ExceptionObject& e) {
+    throw ReadError("cannot read '" + path + "': " + oneLine(e));
+  } catch (const std::bad_alloc&) {
+    throw ReadError("cannot read '" + path + "': out of memory");
+  }
+}
+
+namespace {
+
+template <class T>
+void writeAs(const DenseImage<T>& volume, const std::string& path) {
+  using Image = itk::Image<T, 3>;
+  auto image = Image::New();
+  typename Image::RegionType region;
+  typename Image::SizeType size;
+  const Dims& dims = volume.dims();
+  size[0] = dims.nx;
+  size[1] = dims.ny;
+  size[2] = dims.nz;
+  region.SetSize(size);
+  image->SetRegions(region);
+  const ImageGeometry& g = volume.geometry();
+  typename Image::SpacingType spacing;
+  typename Image::PointType origin;
+  typename Image::DirectionType direction;
+  for (int a = 0; a < 3; ++a) {
+    spacing[a] = g.spacing[a];
+    origin[a] = g.origin[a];
+    for (int b = 0; b < 3; ++b) direction(a, b) = g.direction[a][b];
+  }
+  image->SetSpacing(spacing);
+  image->SetOrigin(origin);
+  image->SetDirection(direction);
+  image->Allocate();
+  std::copy(volume.data().begin(), volume.data().end(), image->GetBufferPointer());
+  auto writer = itk::ImageFileWriter<Image>::New();
+  writer->SetFileName(path);
+  writer->SetInput(image);
+  writer->Update();
+}
+
+}  // namespace
+
+void writeVolume(const AnyVolume& volume, const std::string& path) {
+  registerFactories();
+  try {
+    std::visit([&](const auto& image) { writeAs(image, path); }, volume);
+  } catch (const itk::ExceptionObject& e) {
+    throw std::runtime_error("cannot write '" + path + "': " + oneLine(e));
+  }
+}
+
+namespace {
+
+/// One 2D DICOM file per slice z, with the slice's position, the orientation and the spacing in
+/// its header (ImagePositionPatient, ImageOrientationPatient, PixelSpacing, SliceThickness),
+/// as a scanner writes a series.
+template <class T>
+void writeSeriesAs(const DenseImage<T>& volume, const std::string& directory) {
+  using Image3 = itk::Image<T, 3>;
+  using Image2 = itk::Image<T, 2>;
+  auto image = Image3::New();
+  typename Image3::RegionType region;
+  typename Image3::SizeType size;
+  const Dims& dims = volume.dims();
+  size[0] = dims.nx;
+  size[1] = dims.ny;
+  size[2] = dims.nz;
+  region.SetSize(size);
+  image->SetRegions(region);
+  image->Allocate();
+  std::copy(volume.data().begin(), volume.data().end(), image->GetBufferPointer());
+  const ImageGeometry& g = volume.geometry();
+  typename Image3::SpacingType spacing;
+  typename Image3::PointType origin;
+  typename Image3::DirectionType direction;
+  for (int a = 0; a < 3; ++a) {
+    spacing[a] = g.spacing[a];
+    origin[a] = g.origin[a];
+    for (int b = 0; b < 3; ++b) direction(a, b) = g.direction[a][b];
+  }
+  image->SetSpacing(spacing);
+  image->SetOrigin(origin);
+  image->SetDirection(direction);
+  auto dicom = itk::GDCMImageIO::New();
+  dicom->KeepOriginalUIDOn();
+  gdcm::UIDGenerator uids;
+  const std::string study = uids.Generate(), series = uids.Generate();
+  auto text = [](double v) {
+    std::ostringstream s;
+    s.precision(10);
+    s << v;
+    return s.str();
+  };
+  std::vector<itk::MetaDataDictionary> dictionaries(dims.nz);
+  std::vector<std::string> files;
+  for (int z = 0; z < dims.nz; ++z) {
+    itk::MetaDataDictionary& d = dictionaries[z];
+    const auto p = g.toPhysical({0.0, 0.0, double(z)});
+    auto put = [&](const char* tag, const std::string& value) {
+      itk::EncapsulateMetaData<std::string>(d, tag, value);
+    };
+    put("0008|0060", "CT");
+    put("0008|0016", "1.2.840.10008.5.1.4.1.1.2");  // CT Image Storage
+    put("0020|000d", study);
+    put("0020|000e", series);
+    put("0008|0018", uids.Generate());
+    put("0020|0013", std::to_string(z + 1));
+    put("0020|0032", text(p[0]) + "\\" + text(p[1]) + "\\" + text(p[2]));
+    put("0020|0037", text(g.direction[0][0]) + "\\" + text(g.direction[1][0]) + "\\" + text(g.direction[2][0]) +
+                         "\\" + text(g.direction[0][1]) + "\\" + text(g.direction[1][1]) + "\\" +
+                         text(g.direction[2][1]));
+    put("0028|0030", text(g.spacing[1]) + "\\" + text(g.spacing[0]));  // row spacing \ column spacing
+    put("0018|0050", text(g.spacing[2]));
+    char name[32];
+    std::snprintf(name, sizeof name, "slice%04d.dcm", z);
+    files.push_back((fs::path(directory) / name).string());
+  }
+  auto writer = itk::ImageSeriesWriter<Image3, Image2>::New();
+  writer->SetInput(image);
+  writer->SetImageIO(dicom);
+  writer->SetFileNames(files);
+  std::vector<itk::MetaDataDictionary*> dictionaryPointers;
+  for (auto& d : dictionaries) dictionaryPointers.push_back(&d);
+  writer->SetMetaDataDictionaryArray(&dictionaryPointers);
+  writer->Update();
+}
+
+}  // namespace
+
+void writeDicomSeries(const AnyVolume& volume, const std::string& directory) {
+  registerFactories();
+  try {
+    switch (scalarTypeOf(volume)) {
+      case ScalarType::UInt8: return writeSeriesAs(std::get<DenseImage<std::uint8_t>>(volume), directory);
+      case ScalarType::UInt16: return writeSeriesAs(std::get<DenseImage<std::uint16_t>>(volume), directory);
+      default:
+        throw std::runtime_error("cannot write a DICOM series of " + toString(scalarTypeOf(volume)) +
+                                 " voxels (uint8 and uint16 only)");
+    }
+  } catch (const itk::ExceptionObject& e) {
+    throw std::runtime_error("cannot write the DICOM series '" + directory + "': " + oneLine(e));
+  }
+}
+
+}  // namespace surftrack::io

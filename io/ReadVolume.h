@@ -1,0 +1,78 @@
+// Reading scalar volumes from medical and microscopy image files into the engine's DenseImage,
+// with their physical geometry. ITK does the reading (NIfTI, NRRD, MetaImage, DICOM, ...); it
+// is confined to io/*.cpp so that nothing else pays for its headers. A raw file, whose layout
+// the caller states, is read without ITK.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "Image.h"
+
+namespace surftrack::io {
+
+/// The six voxel types the tool accepts.
+enum class ScalarType { UInt8, Int16, UInt16, Int32, Float32, Float64 };
+
+/// "uint8", "int16", "uint16", "int32", "float", "double".
+std::string toString(ScalarType type);
+
+/// Parses the names above, plus the aliases "float32", "float64", "u8", "i16", "u16", "i32";
+/// throws std::invalid_argument otherwise.
+ScalarType parseScalarType(std::string_view text);
+
+std::size_t sizeOf(ScalarType type);
+
+/// A volume of one of the six types.
+using AnyVolume = std::variant<DenseImage<std::uint8_t>, DenseImage<std::int16_t>,
+                               DenseImage<std::uint16_t>, DenseImage<std::int32_t>,
+                               DenseImage<float>, DenseImage<double>>;
+
+ScalarType scalarTypeOf(const AnyVolume& volume);
+const Dims& dimsOf(const AnyVolume& volume);
+const ImageGeometry& geometryOf(const AnyVolume& volume);
+ImageGeometry& geometryOf(AnyVolume& volume);
+
+/// Any failure to read a volume (missing, unreadable, truncated or malformed file, unsupported
+/// voxel type). The message is one line and names the file.
+class ReadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Reads a volume with ITK. `path` is a file in a format ITK recognises (.nii, .nii.gz, .nrrd,
+/// .nhdr, .mha, .mhd, a single DICOM file, ...) or a directory holding one DICOM series.
+/// 2D images become one slice. Throws ReadError.
+AnyVolume readVolume(const std::string& path);
+
+/// The layout of a headerless raw file: x fastest, then y, then z.
+struct RawLayout {
+  Dims dims;
+  ScalarType type = ScalarType::UInt8;
+  bool bigEndian = false;
+  std::size_t headerBytes = 0;  ///< bytes to skip at the start of the file
+  ImageGeometry geometry;
+};
+
+/// Reads a raw file. The file must hold exactly headerBytes + nx*ny*nz*sizeof(type) bytes.
+/// Throws ReadError.
+AnyVolume readRawVolume(const std::string& path, const RawLayout& layout);
+
+/// Writes a volume with ITK, in the format of the file name's extension (used by the tests and
+/// by the demo to leave its phantom next to the mesh). Throws std::runtime_error.
+void writeVolume(const AnyVolume& volume, const std::string& path);
+
+/// Writes a uint8 or uint16 volume as a DICOM series, one file per slice z in `directory`
+/// (which must exist), with each slice's position, the orientation and the spacing (tests).
+void writeDicomSeries(const AnyVolume& volume, const std::string& directory);
+
+/// The inverse of ImageGeometry::toPhysical: the continuous index of a physical point.
+/// Throws std::invalid_argument if the direction matrix is singular.
+std::array<double, 3> toIndex(const ImageGeometry& geometry, const std::array<double, 3>& point);
+
+}  // namespace surftrack::io

@@ -1,0 +1,677 @@
+// End-to-end tests of the `surftrack` command-line tool: they run the executable on small
+// volumes written with ITK (and on the mricron-data MRI volumes when installed), read the
+// meshes back with OpenMesh, and check every bad input's exit status, one-line message, and
+// that no output file is left behind.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "cli/CliTestSupport.h"
+
+namespace surftrack {
+namespace {
+
+using namespace clitest;
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    root_ = fs::temp_directory_path() /
+            ("surftrack-cli-" + std::to_string(::getpid()) + "-" + info->name());
+    fs::remove_all(root_);
+    work_ = root_ / "work";
+    scratch_ = root_ / "scratch";
+    fs::create_directories(work_);
+    fs::create_directories(scratch_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::permissions(work_, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(root_, ec);
+  }
+
+  std::string path(const std::string& name) const { return (work_ / name).string(); }
+  RunResult run(const std::vector<std::string>& args) const { return runTool(args, scratch_); }
+
+  /// Runs a command that must fail: exit status `code`, one line "surftrack: error: ..."
+  /// containing `needle` on stderr, nothing on stdout, and the work directory unchanged
+  /// (no output, no temporary file).
+  void expectFailure(const std::vector<std::string>& args, int code, const std::string& needle) {
+    const std::vector<std::string> before = listDirectory(work_);
+    const RunResult r = run(args);
+    std::string cmd;
+    for (const auto& a : args) cmd += a + " ";
+    SCOPED_TRACE("surftrack " + cmd);
+    EXPECT_EQ(r.code, code) << r.err;
+    EXPECT_EQ(r.err.rfind("surftrack: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << "stderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(listDirectory(work_), before) << "a file was left behind";
+  }
+
+  static bool isRoot() { return ::geteuid() == 0; }
+
+  fs::path root_, work_, scratch_;
+};
+
+// --- volumes ---------------------------------------------------------------------------------
+
+ImageGeometry skewGeometry() {
+  ImageGeometry g;
+  g.spacing = {0.5, 2.0, 1.5};
+  g.origin = {10.0, -20.0, 5.0};
+  return g;
+}
+
+/// A box of value `in` over [lo, hi] (inclusive) in a volume of `out`.
+template <class T>
+DenseImage<T> boxVolume(Dims dims, Voxel lo, Voxel hi, T in, T out, ImageGeometry g = {}) {
+  DenseImage<T> image(dims, out, g);
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x; ++x) image.at(x, y, z) = in;
+  return image;
+}
+
+/// Adds a ball of value `in`, radius r (voxels with |v - c|^2 <= r^2).
+template <class T>
+void addBall(DenseImage<T>& image, Voxel c, int r, T in) {
+  const Dims& d = image.dims();
+  for (int z = 0; z < d.nz; ++z)
+    for (int y = 0; y < d.ny; ++y)
+      for (int x = 0; x < d.nx; ++x) {
+        const int dx = x - c.x, dy = y - c.y, dz = z - c.z;
+        if (dx * dx + dy * dy + dz * dz <= r * r) image.at(x, y, z) = in;
+      }
+}
+
+template <class T>
+std::size_t surfelsAbove(const DenseImage<T>& image, double iso) {
+  return countBoundarySurfels(image, [iso](T v) { return double(v) > iso; });
+}
+
+void expectNear3(const std::array<double, 3>& a, const std::array<double, 3>& b, double tol,
+                 const std::string& what) {
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(a[i], b[i], tol) << what << " axis " << i;
+}
+
+/// The checks on a good run: exit 0, JSON surfels, the mesh read back with OpenMesh is a
+/// closed manifold with one vertex per surfel, the tool's triangle count, and the expected
+/// physical bounding box.
+void expectGoodMesh(const RunResult& r, const fs::path& mesh, std::size_t surfels,
+                    const std::optional<std::pair<std::array<double, 3>, std::array<double, 3>>>& box) {
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(jsonNumber(r.out, "surfels"), double(surfels));
+  EXPECT_EQ(jsonNumber(r.out, "vertices"), double(surfels));
+  EXPECT_EQ(jsonBool(r.out, "closed"), std::optional<bool>(true));
+  EXPECT_EQ(jsonBool(r.out, "manifold"), std::optional<bool>(true));
+  const MeshCheck c = checkMeshFile(mesh);
+  ASSERT_TRUE(c.read) << mesh;
+  EXPECT_EQ(c.vertices, surfels) << mesh;
+  EXPECT_EQ(double(c.faces), jsonNumber(r.out, "triangles")) << mesh;
+  EXPECT_TRUE(c.closed) << mesh;
+  EXPECT_TRUE(c.manifold) << mesh;
+  if (box) {
+    expectNear3(c.min, box->first, 1e-3, mesh.string() + " bbox min");
+    expectNear3(c.max, box->second, 1e-3, mesh.string() + " bbox max");
+  }
+}
+
+// --- reading: every input format, spacing != 1, non-zero origin ------------------------------
+
+TEST_F(Cli, ReadsEveryInputFormatInPhysicalCoordinates) {
+  const Dims dims{20, 18, 16};
+  const Voxel lo{4, 5, 3}, hi{12, 11, 10};
+  const ImageGeometry g = skewGeometry();
+  const auto image = boxVolume<std::int16_t>(dims, lo, hi, 100, 0, g);
+  const std::size_t surfels = surfelsAbove(image, 50);
+  ASSERT_EQ(surfels, 2u * (9 * 7 + 7 * 8 + 9 * 8));
+  const auto box = physicalBox(g, {lo.x - 0.5, lo.y - 0.5, lo.z - 0.5}, {hi.x + 0.5, hi.y + 0.5, hi.z + 0.5});
+  for (const std::string ext : {".nii", ".nii.gz", ".nrrd", ".nhdr", ".mha", ".mhd"}) {
+    SCOPED_TRACE(ext);
+    const std::string in = path("box" + ext), out = path("box" + ext + ".ply");
+    io::writeVolume(io::AnyVolume(image), in);
+    const RunResult r = run({"mesh", in, "-o", out, "--iso", "50", "--mapping", "midpoint", "--json"});
+    expectGoodMesh(r, out, surfels, box);
+    EXPECT_EQ(jsonString(r.out, "type"), "int16");
+  }
+  // A raw file: the layout and the geometry on the command line.
+  const std::string raw = path("box.raw"), out = path("box.raw.ply");
+  {
+    std::ofstream f(raw, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(image.data().data()), std::streamsize(image.data().size() * 2));
+  }
+  const RunResult r = run({"mesh", raw, "-o", out, "--raw-dims", "20,18,16", "--raw-type", "int16", "--spacing",
+                           "0.5,2,1.5", "--origin", "10,-20,5", "--iso", "50", "--mapping", "midpoint", "--json"});
+  expectGoodMesh(r, out, surfels, box);
+  // Big-endian raw with a header.
+  const std::string rawBig = path("box-be.raw"), outBig = path("box-be.ply");
+  {
+    std::ofstream f(rawBig, std::ios::binary);
+    f.write("HEADER", 6);
+    for (std::int16_t v : image.data()) {
+      const char bytes[2] = {char((std::uint16_t(v) >> 8) & 0xFF), char(std::uint16_t(v) & 0xFF)};
+      f.write(bytes, 2);
+    }
+  }
+  const RunResult rb = run({"mesh", rawBig, "-o", outBig, "--raw-dims=20,18,16", "--raw-type=int16", "--raw-endian",
+                            "big", "--raw-header", "6", "--spacing", "0.5,2,1.5", "--origin", "10,-20,5", "--iso",
+                            "50", "--mapping", "midpoint", "--json"});
+  expectGoodMesh(rb, outBig, surfels, box);
+}
+
+TEST_F(Cli, ReadsADicomSeries) {
+  // A directory of one 2D DICOM file per slice, as a scanner writes it: the spacing, origin
+  // and direction come from the slices' headers.
+  ImageGeometry g;
+  g.spacing = {0.75, 0.8, 2.0};
+  g.origin = {-30.0, 12.5, 40.0};
+  g.direction = {{{0, -1, 0}, {1, 0, 0}, {0, 0, 1}}};
+  const Voxel lo{3, 4, 2}, hi{10, 9, 6};
+  const auto image = boxVolume<std::uint16_t>(Dims{14, 12, 9}, lo, hi, 1000, 0, g);
+  fs::create_directories(work_ / "series");
+  io::writeDicomSeries(io::AnyVolume(image), path("series"));
+  const std::size_t surfels = surfelsAbove(image, 500);
+  const auto box = physicalBox(g, {lo.x - 0.5, lo.y - 0.5, lo.z - 0.5}, {hi.x + 0.5, hi.y + 0.5, hi.z + 0.5});
+  const RunResult r = run({"mesh", path("series"), "-o", path("ct.stl"), "--iso", "500", "--json"});
+  expectGoodMesh(r, path("ct.stl"), surfels, box);
+  EXPECT_EQ(jsonArray(r.out, "spacing"), "0.75,0.8,2");
+  EXPECT_EQ(jsonArray(r.out, "dims"), "14,12,9");
+}
+
+TEST_F(Cli, AppliesTheDirectionMatrix) {
+  ImageGeometry g = skewGeometry();
+  g.direction = {{{0, -1, 0}, {1, 0, 0}, {0, 0, 1}}};  // 90 degrees about z
+  const Voxel lo{2, 3, 4}, hi{9, 5, 6};
+  const auto image = boxVolume<std::uint8_t>(Dims{12, 10, 9}, lo, hi, 200, 10, g);
+  const std::size_t surfels = surfelsAbove(image, 100);
+  // The linear mapping puts each vertex at t = (100 - 200) / (10 - 200) from its inside voxel.
+  const double t = 100.0 / 190.0;
+  const auto box = physicalBox(g, {lo.x - t, lo.y - t, lo.z - t}, {hi.x + t, hi.y + t, hi.z + t});
+  for (const std::string ext : {".nrrd", ".mha", ".nii.gz"}) {
+    SCOPED_TRACE(ext);
+    const std::string in = path("rot" + ext), out = path("rot" + ext + ".off");
+    io::writeVolume(io::AnyVolume(image), in);
+    expectGoodMesh(run({"mesh", in, "-o", out, "--iso", "100", "--json"}), out, surfels, box);
+  }
+}
+
+// --- writing: every mesh format --------------------------------------------------------------
+
+TEST_F(Cli, WritesEveryMeshFormat) {
+  const ImageGeometry g = skewGeometry();
+  DenseImage<std::uint8_t> image(Dims{16, 16, 16}, 0, g);
+  addBall<std::uint8_t>(image, Voxel{8, 7, 8}, 5, 255);
+  const std::string in = path("ball.nrrd");
+  io::writeVolume(io::AnyVolume(image), in);
+  const std::size_t surfels = surfelsAbove(image, 127.5);
+  struct Case {
+    std::string name;
+    std::vector<std::string> extra;
+    std::string header;  // how the file starts
+  };
+  const std::vector<Case> cases = {
+      {"ball.ply", {}, "ply\nformat binary_little_endian"},
+      {"ball-ascii.ply", {"--ascii"}, "ply\nformat ascii"},
+      {"ball.obj", {}, ""},
+      {"ball.off", {}, "OFF"},
+      {"ball.stl", {}, ""},
+      {"ball-ascii.stl", {"--ascii"}, "solid"},
+      {"BALL.PLY", {}, "ply"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    std::vector<std::string> args = {"mesh", in, "-o", path(c.name), "--iso", "127.5", "--mapping", "midpoint", "--json"};
+    args.insert(args.end(), c.extra.begin(), c.extra.end());
+    const RunResult r = run(args);
+    const auto box = physicalBox(g, {8 - 5.5, 7 - 5.5, 8 - 5.5}, {8 + 5.5, 7 + 5.5, 8 + 5.5});
+    expectGoodMesh(r, path(c.name), surfels, box);
+    EXPECT_EQ(readText(path(c.name)).rfind(c.header, 0), 0u);
+  }
+  // The same vertices with the linear mapping stay strictly inside the midpoint box's cells.
+  const RunResult r = run({"mesh", in, "-o", path("linear.ply"), "--iso", "127.5", "--json"});
+  expectGoodMesh(r, path("linear.ply"), surfels, std::nullopt);
+  EXPECT_EQ(jsonString(r.out, "mapping"), "linear");
+}
+
+// --- the six voxel types ---------------------------------------------------------------------
+
+template <class T>
+void writeBall(const std::string& file) {
+  DenseImage<T> image(Dims{14, 13, 12}, T(0));
+  addBall<T>(image, Voxel{7, 6, 6}, 4, T(100));
+  io::writeVolume(io::AnyVolume(image), file);
+}
+
+TEST_F(Cli, ReadsAllSixVoxelTypes) {
+  writeBall<std::uint8_t>(path("uint8.nrrd"));
+  writeBall<std::int16_t>(path("int16.nrrd"));
+  writeBall<std::uint16_t>(path("uint16.nrrd"));
+  writeBall<std::int32_t>(path("int32.mha"));
+  writeBall<float>(path("float.nii"));
+  writeBall<double>(path("double.nrrd"));
+  DenseImage<std::uint8_t> ref(Dims{14, 13, 12}, 0);
+  addBall<std::uint8_t>(ref, Voxel{7, 6, 6}, 4, 100);
+  const std::size_t surfels = surfelsAbove(ref, 50);
+  for (const std::string name : {"uint8.nrrd", "int16.nrrd", "uint16.nrrd", "int32.mha", "float.nii", "double.nrrd"}) {
+    SCOPED_TRACE(name);
+    const RunResult r = run({"mesh", path(name), "-o", path(name + ".ply"), "--iso", "50", "--json"});
+    expectGoodMesh(r, path(name + ".ply"), surfels, std::nullopt);
+    EXPECT_EQ(jsonString(r.out, "type"), name.substr(0, name.find('.')));
+    EXPECT_EQ(jsonNumber(r.out, "genus"), 0.0);
+  }
+}
+
+// --- seeds -----------------------------------------------------------------------------------
+
+class CliSeeds : public Cli {
+ protected:
+  void SetUp() override {
+    Cli::SetUp();
+    geometry_.spacing = {2, 1, 1};
+    geometry_.origin = {-5, 3, 7};
+    image_ = DenseImage<std::uint8_t>(Dims{36, 20, 20}, 0, geometry_);
+    addBall<std::uint8_t>(image_, Voxel{10, 10, 10}, 6, 200);  // A: x in [4, 16]
+    addBall<std::uint8_t>(image_, Voxel{26, 10, 10}, 4, 200);  // B: x in [22, 30]
+    DenseImage<std::uint8_t> a(image_.dims(), 0), b(image_.dims(), 0);
+    addBall<std::uint8_t>(a, Voxel{10, 10, 10}, 6, 200);
+    addBall<std::uint8_t>(b, Voxel{26, 10, 10}, 4, 200);
+    surfelsA_ = surfelsAbove(a, 100);
+    surfelsB_ = surfelsAbove(b, 100);
+    input_ = path("balls.nii.gz");
+    io::writeVolume(io::AnyVolume(image_), input_);
+  }
+  RunResult mesh(std::vector<std::string> extra, const std::string& out = "out.ply") {
+    std::vector<std::string> args = {"mesh", input_, "-o", path(out), "--iso", "100"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  }
+  ImageGeometry geometry_;
+  DenseImage<std::uint8_t> image_;
+  std::size_t surfelsA_ = 0, surfelsB_ = 0;
+  std::string input_;
+};
+
+TEST_F(CliSeeds, VoxelInsideWalksPlusXToTheFirstSurfel) {
+  RunResult r = mesh({"--seed", "26,10,10", "--json"});
+  expectGoodMesh(r, path("out.ply"), surfelsB_, std::nullopt);
+  EXPECT_EQ(jsonString(r.out, "walk_direction"), "+x");
+  EXPECT_EQ(jsonNumber(r.out, "walk_steps"), 4.0);
+  EXPECT_EQ(jsonBool(r.out, "voxel_inside"), std::optional<bool>(true));
+  // The summary names the surfel used.
+  r = mesh({"--seed", "26,10,10"}, "out2.ply");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("voxel (26,10,10) (inside), 4 voxels along +x to surfel c=(30,10,10) d=(31,10,10)"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(CliSeeds, VoxelOutsideWalksToTheFirstInsideVoxel) {
+  const RunResult r = mesh({"--seed", "18,10,10", "--json"});
+  expectGoodMesh(r, path("out.ply"), surfelsB_, std::nullopt);
+  EXPECT_EQ(jsonBool(r.out, "voxel_inside"), std::optional<bool>(false));
+  EXPECT_EQ(jsonArray(r.out, "c"), "22,10,10") << r.out;
+  EXPECT_EQ(jsonArray(r.out, "d"), "21,10,10") << r.out;
+  // From (0,0,0), +x meets nothing, -x leaves the domain at once, +y ... : no ray reaches a
+  // ball, but from (10,0,10) the +y ray (second try after +x, -x) reaches A.
+  const RunResult r2 = mesh({"--seed", "10,0,10", "--json"}, "out2.ply");
+  expectGoodMesh(r2, path("out2.ply"), surfelsA_, std::nullopt);
+  EXPECT_EQ(jsonString(r2.out, "walk_direction"), "+y");
+}
+
+TEST_F(CliSeeds, PhysicalPointGoesToTheNearestVoxel) {
+  // Voxel (10,10,10) is at (-5 + 2*10, 3 + 10, 7 + 10) = (15, 13, 17).
+  const RunResult r = mesh({"--seed-point", "15.4,13.2,16.8", "--json"});
+  expectGoodMesh(r, path("out.ply"), surfelsA_, std::nullopt);
+  EXPECT_EQ(jsonArray(r.out, "voxel"), "10,10,10") << r.out;
+  EXPECT_EQ(jsonArray(r.out, "point"), "15.4,13.2,16.8") << r.out;
+}
+
+TEST_F(CliSeeds, SurfelLargestAndAll) {
+  RunResult r = mesh({"--seed", "30,10,10,+x", "--json"});
+  expectGoodMesh(r, path("out.ply"), surfelsB_, std::nullopt);
+  r = mesh({"--largest", "--json"}, "largest.ply");
+  expectGoodMesh(r, path("largest.ply"), surfelsA_, std::nullopt);
+  EXPECT_EQ(jsonNumber(r.out, "boundaries"), 2.0);
+  r = mesh({"--json"}, "default.ply");  // --largest is the default
+  expectGoodMesh(r, path("default.ply"), surfelsA_, std::nullopt);
+  r = mesh({"--all", "--json"}, "all.ply");
+  expectGoodMesh(r, path("all.ply"), surfelsA_ + surfelsB_, std::nullopt);
+  EXPECT_EQ(jsonNumber(r.out, "components"), 2.0);
+  EXPECT_EQ(jsonNumber(r.out, "euler_characteristic"), 4.0);
+}
+
+TEST_F(CliSeeds, EveryAdjacencyPair) {
+  for (const std::string pair : {"26-6", "18-6", "6-18", "6-26"}) {
+    SCOPED_TRACE(pair);
+    const RunResult r = mesh({"--adjacency", pair, "--seed", "26,10,10", "--json"}, "pair" + pair + ".obj");
+    expectGoodMesh(r, path("pair" + pair + ".obj"), surfelsB_, std::nullopt);
+    EXPECT_EQ(jsonString(r.out, "adjacency"), pair);
+  }
+}
+
+// --- labels, topology ------------------------------------------------------------------------
+
+TEST_F(Cli, LabelSurfelsEqualTheDirectCount) {
+  // Label 2: a thick shell around a cavity of label 3 (two boundaries); label 1: a box.
+  DenseImage<std::int16_t> image(Dims{24, 20, 20}, 0);
+  addBall<std::int16_t>(image, Voxel{12, 10, 10}, 8, 2);
+  addBall<std::int16_t>(image, Voxel{12, 10, 10}, 3, 3);
+  for (int z = 1; z < 4; ++z)
+    for (int y = 1; y < 5; ++y)
+      for (int x = 1; x < 6; ++x) image.at(x, y, z) = 1;
+  io::writeVolume(io::AnyVolume(image), path("labels.nrrd"));
+  for (int label : {1, 2, 3}) {
+    SCOPED_TRACE(label);
+    const std::size_t direct = countBoundarySurfels(image, [label](std::int16_t v) { return v == label; });
+    const std::string out = path("label" + std::to_string(label) + ".ply");
+    const RunResult r = run({"mesh", path("labels.nrrd"), "-o", out, "--label", std::to_string(label), "--all", "--json"});
+    expectGoodMesh(r, out, direct, std::nullopt);
+    EXPECT_EQ(jsonNumber(r.out, "components"), label == 2 ? 2.0 : 1.0);
+    EXPECT_EQ(jsonString(r.out, "mapping"), "midpoint");
+  }
+}
+
+TEST_F(Cli, EulerCharacteristicAndGenus) {
+  // A square ring: a box with a hole through it (genus 1), and a box with two holes (genus 2).
+  DenseImage<std::uint8_t> image(Dims{30, 12, 8}, 0);
+  for (int z = 2; z <= 5; ++z)
+    for (int y = 2; y <= 9; ++y) {
+      for (int x = 2; x <= 9; ++x)
+        if (!(x >= 4 && x <= 7 && y >= 4 && y <= 7)) image.at(x, y, z) = 1;
+      for (int x = 14; x <= 27; ++x)
+        if (!(y >= 4 && y <= 7 && ((x >= 16 && x <= 19) || (x >= 22 && x <= 25)))) image.at(x, y, z) = 1;
+    }
+  io::writeVolume(io::AnyVolume(image), path("rings.mha"));
+  RunResult r = run({"mesh", path("rings.mha"), "-o", path("ring.ply"), "--iso", "0.5", "--seed", "2,5,3", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(jsonNumber(r.out, "euler_characteristic"), 0.0);
+  EXPECT_EQ(jsonNumber(r.out, "genus"), 1.0);
+  r = run({"mesh", path("rings.mha"), "-o", path("ring2.ply"), "--iso", "0.5", "--seed", "20,5,3", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(jsonNumber(r.out, "euler_characteristic"), -2.0);
+  EXPECT_EQ(jsonNumber(r.out, "genus"), 2.0);
+  r = run({"mesh", path("rings.mha"), "-o", path("both.ply"), "--iso", "0.5", "--all"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("Euler characteristic -2 in total; by genus: 1 x1 2 x1"), std::string::npos) << r.out;
+}
+
+// --- output for people and scripts ----------------------------------------------------------
+
+TEST_F(Cli, SummaryJsonAndQuiet) {
+  DenseImage<std::uint8_t> image(Dims{16, 16, 16}, 0);
+  addBall<std::uint8_t>(image, Voxel{8, 8, 8}, 5, 255);
+  io::writeVolume(io::AnyVolume(image), path("ball.nrrd"));
+  RunResult r = run({"mesh", path("ball.nrrd"), "-o", path("a.ply")});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  for (const char* line : {"image ", "values ", "surface ", "seed ", "mesh ", "topology ", "bbox ", "output ",
+                           "timings ", "surfels", "genus 0", "closed 2-manifold", "Otsu"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  EXPECT_LE(std::count(r.out.begin(), r.out.end(), '\n'), 24);  // one screen
+
+  r = run({"mesh", path("ball.nrrd"), "-o", path("b.ply"), "--quiet"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "");
+  EXPECT_TRUE(fs::exists(path("b.ply")));
+
+  r = run({"mesh", path("ball.nrrd"), "-o", path("c.ply"), "--json"});
+  ASSERT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.front(), '{');
+  for (const char* key : {"surfels", "vertices", "triangles", "components", "euler_characteristic", "genus"})
+    EXPECT_FALSE(std::isnan(jsonNumber(r.out, key))) << key;
+  for (const char* key : {"read", "track", "convert", "write", "total"})
+    EXPECT_FALSE(std::isnan(jsonNumber(r.out, key))) << key;
+
+  r = run({"info", path("ball.nrrd")});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("16 x 16 x 16"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("uint8"), std::string::npos);
+  r = run({"info", path("ball.nrrd"), "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(jsonNumber(r.out, "max"), 255.0);
+  EXPECT_EQ(jsonNumber(r.out, "otsu"), 127.5);
+
+  r = run({"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("usage: surftrack"), std::string::npos);
+  r = run({"mesh", "--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--seed-point"), std::string::npos);
+}
+
+TEST_F(Cli, DemoPhantom) {
+  const std::string dir = path("demo");
+  const RunResult r = run({"demo", "-o", dir, "--no-mricron", "--size", "48", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(jsonBool(r.out, "closed"), std::optional<bool>(true));
+  const double surfels = jsonNumber(r.out, "surfels");
+  const MeshCheck c = checkMeshFile(dir + "/phantom.ply");
+  ASSERT_TRUE(c.read);
+  EXPECT_TRUE(c.closed && c.manifold);
+  EXPECT_EQ(double(c.vertices), surfels);
+  // The printed equivalent command gives the same surface from the written phantom volume.
+  ASSERT_TRUE(fs::exists(dir + "/phantom.nrrd"));
+  const std::string command = jsonString(r.out, "command");
+  ASSERT_NE(command.find("--seed "), std::string::npos) << command;
+  std::string seed = command.substr(command.find("--seed ") + 7);
+  seed = seed.substr(0, seed.find(' '));
+  const RunResult again = run({"mesh", dir + "/phantom.nrrd", "-o", path("again.ply"), "--iso", "127.5", "--seed",
+                               seed, "--json"});
+  expectGoodMesh(again, path("again.ply"), std::size_t(surfels), std::nullopt);
+  // Without mricron-data the demo says so and still succeeds.
+  const RunResult without = run({"demo", "-o", path("demo2"), "--size", "24", "--mricron-dir", path("none")});
+  ASSERT_EQ(without.code, 0) << without.err;
+  EXPECT_NE(without.out.find("mricron-data is not installed"), std::string::npos) << without.out;
+  EXPECT_NE(without.out.find("demo: 1 mesh written to"), std::string::npos) << without.out;
+}
+
+// --- bad input: a clear one-line error, a non-zero exit, no file left behind ----------------
+
+TEST_F(Cli, MissingFile) {
+  expectFailure({"mesh", path("nope.nii.gz"), "-o", path("out.ply")}, 1, "no such file");
+  expectFailure({"info", path("nope.nrrd")}, 1, "no such file");
+  expectFailure({"mesh", path("nope.raw"), "-o", path("out.ply"), "--raw-dims", "2,2,2", "--raw-type", "uint8"}, 1,
+                "no such file");
+}
+
+TEST_F(Cli, UnreadableFile) {
+  {
+    std::ofstream(path("garbage.nrrd")) << "this is not an image\n";
+    std::ofstream(path("garbage.nii.gz")) << "neither is this";
+    std::ofstream(path("garbage.dat")) << "nor this";
+    std::ofstream(path("empty.nii"));
+  }
+  expectFailure({"mesh", path("garbage.nrrd"), "-o", path("out.ply")}, 1, "garbage.nrrd");
+  expectFailure({"mesh", path("garbage.nii.gz"), "-o", path("out.ply")}, 1, "cannot read");
+  expectFailure({"mesh", path("garbage.dat"), "-o", path("out.ply")}, 1, "not a recognised image file");
+  expectFailure({"mesh", path("empty.nii"), "-o", path("out.ply")}, 1, "empty");
+  fs::create_directories(work_ / "nodicom");
+  expectFailure({"mesh", path("nodicom"), "-o", path("out.ply")}, 1, "no DICOM series");
+  if (!isRoot()) {  // root reads files whatever their permissions
+    DenseImage<std::uint8_t> image(Dims{4, 4, 4}, 1);
+    io::writeVolume(io::AnyVolume(image), path("locked.nrrd"));
+    fs::permissions(path("locked.nrrd"), fs::perms::none);
+    expectFailure({"mesh", path("locked.nrrd"), "-o", path("out.ply")}, 1, "cannot open");
+  }
+}
+
+TEST_F(Cli, TruncatedFile) {
+  DenseImage<std::int16_t> image(Dims{20, 20, 20}, 0);
+  addBall<std::int16_t>(image, Voxel{10, 10, 10}, 6, 100);
+  auto truncate = [](const fs::path& p) { fs::resize_file(p, fs::file_size(p) / 2); };
+  for (const std::string ext : {".nii", ".nii.gz", ".nrrd", ".mha"}) {
+    const std::string in = path("cut" + ext);
+    io::writeVolume(io::AnyVolume(image), in);
+    truncate(in);
+    SCOPED_TRACE(ext);
+    expectFailure({"mesh", in, "-o", path("out.ply"), "--iso", "50"}, 1, "cut" + ext);
+  }
+  // A detached header whose data file is cut short.
+  io::writeVolume(io::AnyVolume(image), path("cut.mhd"));
+  truncate(work_ / "cut.raw");
+  expectFailure({"mesh", path("cut.mhd"), "-o", path("out.ply"), "--iso", "50"}, 1, "truncated");
+  io::writeVolume(io::AnyVolume(image), path("cutn.nhdr"));
+  for (const auto& e : fs::directory_iterator(work_))
+    if (e.path().filename().string().rfind("cutn.", 0) == 0 && e.path().extension() != ".nhdr") truncate(e.path());
+  expectFailure({"mesh", path("cutn.nhdr"), "-o", path("out.ply"), "--iso", "50"}, 1, "cutn.nhdr");
+  // A raw file shorter than its stated size.
+  { std::ofstream(path("short.raw"), std::ios::binary) << std::string(100, '\1'); }
+  expectFailure({"mesh", path("short.raw"), "-o", path("out.ply"), "--raw-dims", "10,10,10", "--raw-type", "uint8"},
+                1, "truncated");
+}
+
+TEST_F(Cli, UnsupportedVoxelType) {
+  auto nrrd = [&](const std::string& name, const std::string& type, std::size_t bytes) {
+    std::ofstream f(path(name), std::ios::binary);
+    f << "NRRD0004\ntype: " << type << "\ndimension: 3\nsizes: 4 4 4\nencoding: raw\nendian: little\n\n";
+    f << std::string(64 * bytes, '\0');
+  };
+  nrrd("u32.nrrd", "uint32", 4);
+  nrrd("i8.nrrd", "int8", 1);
+  nrrd("i64.nrrd", "int64", 8);
+  expectFailure({"mesh", path("u32.nrrd"), "-o", path("out.ply")}, 1, "unsupported voxel type");
+  expectFailure({"mesh", path("i8.nrrd"), "-o", path("out.ply")}, 1, "unsupported voxel type");
+  expectFailure({"info", path("i64.nrrd")}, 1, "unsupported voxel type");
+  { std::ofstream(path("x.raw"), std::ios::binary) << std::string(8, '\0'); }
+  expectFailure({"mesh", path("x.raw"), "-o", path("out.ply"), "--raw-dims", "2,2,2", "--raw-type", "int8"}, 2,
+                "unsupported voxel type");
+}
+
+class CliErrors : public Cli {
+ protected:
+  void SetUp() override {
+    Cli::SetUp();
+    DenseImage<std::uint8_t> image(Dims{20, 20, 20}, 10);
+    addBall<std::uint8_t>(image, Voxel{4, 4, 4}, 2, 200);
+    input_ = path("small.nrrd");
+    io::writeVolume(io::AnyVolume(image), input_);
+  }
+  std::string input_;
+};
+
+TEST_F(CliErrors, IsoValueOutsideTheDataRange) {
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "200"}, 1, "outside the data range [10, 200]");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "1e6"}, 1, "no voxel is above it");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "-3"}, 1, "every voxel would be inside");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "nan"}, 2, "not a number");
+}
+
+TEST_F(CliErrors, SeedOutsideTheDomain) {
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "20,0,0"}, 1,
+                "seed voxel (20,0,0) lies outside the image domain [0,20)x[0,20)x[0,20)");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "-1,5,5"}, 1, "outside the image");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed-point", "1000,0,0"}, 1,
+                "outside the image");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "25,1,1,+x"}, 1,
+                "outside the image domain");
+}
+
+TEST_F(CliErrors, SeedNotOnAnyBoundary) {
+  // The ball occupies [2, 6]^3: no axis ray from (12,12,12) meets it.
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "12,12,12"}, 1,
+                "seed voxel (12,12,12) is not on any boundary");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "12,12,12,+y"}, 1,
+                "is not a boundary surfel");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "4,4,4,+x"}, 1,
+                "is not a boundary surfel");
+}
+
+TEST_F(CliErrors, EmptySelection) {
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--label", "7"}, 1, "empty selection: label 7 does not occur");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--label", "7", "--all"}, 1, "empty selection");
+  DenseImage<float> flat(Dims{5, 5, 5}, 3.5f);
+  io::writeVolume(io::AnyVolume(flat), path("flat.nrrd"));
+  expectFailure({"mesh", path("flat.nrrd"), "-o", path("out.ply")}, 1, "constant");
+}
+
+TEST_F(CliErrors, OutputCannotBeWritten) {
+  expectFailure({"mesh", input_, "-o", path("missing/out.ply"), "--iso", "100"}, 1, "does not exist");
+  fs::create_directories(work_ / "adir.ply");
+  expectFailure({"mesh", input_, "-o", path("adir.ply"), "--iso", "100"}, 1, "is a directory");
+  expectFailure({"mesh", input_, "-o", path("out.xyz"), "--iso", "100"}, 2, "unknown mesh format '.xyz'");
+  expectFailure({"mesh", input_, "-o", path("noext"), "--iso", "100"}, 2, "unknown mesh format");
+  // A failed run leaves an existing output untouched.
+  { std::ofstream(path("keep.ply")) << "old content"; }
+  expectFailure({"mesh", input_, "-o", path("keep.ply"), "--iso", "1000"}, 1, "outside the data range");
+  EXPECT_EQ(readText(path("keep.ply")), "old content");
+  if (!isRoot()) {
+    fs::create_directories(work_ / "ro");
+    fs::permissions(work_ / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    expectFailure({"mesh", input_, "-o", path("ro/out.ply"), "--iso", "100"}, 1, "not writable");
+  }
+  // The demo directory cannot be created under a file.
+  expectFailure({"demo", "-o", path("keep.ply/sub"), "--no-mricron", "--size", "16"}, 1, "cannot create");
+}
+
+TEST_F(CliErrors, UsageErrors) {
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--frobnicate"}, 2, "unknown option '--frobnicate'");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "1", "--label", "2"}, 2, "not both");
+  expectFailure({"mesh", input_}, 2, "missing the output mesh");
+  expectFailure({"mesh", "-o", path("out.ply")}, 2, "missing the input volume");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--seed", "1,2"}, 2, "--seed");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--seed", "1,2,3", "--all"}, 2, "only one of");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--adjacency", "6-6"}, 2, "unsupported adjacency pair");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--mapping", "cubic"}, 2, "--mapping");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--label", "1", "--mapping", "linear"}, 2, "needs --iso");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--raw-type", "uint8"}, 2, "need --raw-dims");
+  expectFailure({"frobnicate"}, 2, "unknown command 'frobnicate'");
+}
+
+// --- the real MRI volumes of mricron-data ----------------------------------------------------
+
+const fs::path kMricron = "/usr/share/mricron/templates";
+
+TEST_F(Cli, MricronDemoSurfacesAreClosedManifolds) {
+  if (!fs::exists(kMricron / "ch2better.nii.gz") || !fs::exists(kMricron / "aal.nii.gz"))
+    GTEST_SKIP() << "mricron-data is not installed (" << kMricron << "): apt-get install mricron-data";
+  const std::string dir = path("demo");
+  const RunResult r = run({"demo", "-o", dir, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The results, one JSON object each, in the order phantom, cortex, atlas region.
+  std::vector<std::string> results;
+  for (std::size_t at = r.out.find("\"name\": "); at != std::string::npos;) {
+    const std::size_t next = r.out.find("\"name\": ", at + 1);
+    results.push_back(r.out.substr(at, next == std::string::npos ? std::string::npos : next - at));
+    at = next;
+  }
+  ASSERT_EQ(results.size(), 3u) << r.out;
+  const std::vector<std::string> meshes = {"phantom.ply", "cortex.ply", "aal-Precentral_L.ply"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    SCOPED_TRACE(meshes[i]);
+    const std::string& json = results[i];
+    EXPECT_NE(json.find(meshes[i]), std::string::npos);
+    const MeshCheck c = checkMeshFile(dir + "/" + meshes[i]);
+    ASSERT_TRUE(c.read);
+    EXPECT_TRUE(c.closed);
+    EXPECT_TRUE(c.manifold);
+    EXPECT_EQ(double(c.vertices), jsonNumber(json, "surfels"));
+    EXPECT_EQ(double(c.faces), jsonNumber(json, "triangles"));
+    EXPECT_EQ(jsonBool(json, "closed"), std::optional<bool>(true));
+    EXPECT_EQ(jsonNumber(json, "components"), 1.0);
+  }
+  EXPECT_EQ(r.out.find("mricron-data is not installed"), std::string::npos);
+}
+
+TEST_F(Cli, MricronLabelSurfelsEqualTheDirectCount) {
+  const fs::path atlas = kMricron / "aal.nii.gz";
+  if (!fs::exists(atlas)) GTEST_SKIP() << "mricron-data is not installed (" << atlas << "): apt-get install mricron-data";
+  const io::AnyVolume volume = io::readVolume(atlas.string());
+  ASSERT_EQ(io::scalarTypeOf(volume), io::ScalarType::UInt8);
+  const auto& image = std::get<DenseImage<std::uint8_t>>(volume);
+  for (int label : {1, 2, 37, 116}) {
+    SCOPED_TRACE(label);
+    const std::size_t direct = countBoundarySurfels(image, [label](std::uint8_t v) { return v == label; });
+    ASSERT_GT(direct, 0u);
+    const std::string out = path("aal" + std::to_string(label) + ".ply");
+    const RunResult r = run({"mesh", atlas.string(), "-o", out, "--label", std::to_string(label), "--all", "--json"});
+    expectGoodMesh(r, out, direct, std::nullopt);
+  }
+}
+
+}  // namespace
+}  // namespace surftrack
