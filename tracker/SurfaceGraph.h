@@ -13,7 +13,9 @@
 namespace surftrack {
 
 /// A Boost.Graph CSR graph; every beta-arc {s, t} is stored as the two arcs s->t and t->s,
-/// so out-edges of a vertex are its beta-neighbours.
+/// so out-edges of a vertex are its beta-neighbours. Their order is that of betaNeighbours:
+/// first the 4 edge neighbours, one per direction e orthogonal to the normal, by increasing
+/// Direction code; then the strict-26 links. The converter relies on that order.
 using SurfelGraph = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property,
                                                        boost::no_property, boost::no_property,
                                                        std::uint32_t, std::uint32_t>;

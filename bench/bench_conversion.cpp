@@ -1,0 +1,90 @@
+// Conversion throughput (issue 3): from a tracked surface graph to the indexed triangle list
+// (extractLoops, paper §5.2), then, separately, the iso-value mapping of the vertices and the
+// construction of the OpenMesh half-edge mesh, on the noisy spheres of spec.md §7.
+// Medians of several runs, one thread.
+//
+//   bench_conversion [--sizes 64,128,...] [--reps N] [--pair 26-6]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "BoundaryMapping.h"
+#include "LoopExtraction.h"
+#include "SphereImage.h"
+#include "SurfaceMesh.h"
+#include "TrackComponent.h"
+
+using namespace surftrack;
+
+namespace {
+
+template <class F>
+double medianSeconds(int reps, F&& f) {
+  std::vector<double> t;
+  for (int r = 0; r < reps; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    std::vector<int> sizes{128, 256, 512};
+    int reps = 5;
+    AdjacencyPair pair = AdjacencyPair::k26_6;
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+        return argv[++i];
+      };
+      if (a == "--sizes") {
+        sizes.clear();
+        std::stringstream ss(value());
+        for (std::string item; std::getline(ss, item, ',');) sizes.push_back(std::stoi(item));
+      } else if (a == "--reps") {
+        reps = std::stoi(value());
+      } else if (a == "--pair") {
+        pair = parseAdjacencyPair(value());
+      } else {
+        throw std::invalid_argument("unknown option " + a);
+      }
+    }
+    std::printf("conversion, pair %s, median of %d runs, one thread (ms; M triangles/s)\n",
+                toString(pair).c_str(), reps);
+    std::printf("%-18s %10s %10s %10s %8s %10s %10s %8s\n", "case", "triangles", "track",
+                "loops", "M tri/s", "mapping", "openmesh", "M tri/s");
+    for (int q : sizes)
+      for (double noise : {0.0, 0.01, 0.05}) {
+        const bench::NoisySphere sphere = bench::makeNoisySphere(q, noise);
+        const auto image = sphere.binary();
+        const Surfel seed = bench::protocolSeed(sphere);
+        SurfaceGraph graph;
+        const double track = medianSeconds(reps, [&] { graph = trackComponent(image, seed, pair); });
+        TriangleMesh mesh;
+        const double loops = medianSeconds(reps, [&] { mesh = extractLoops(image, graph); });
+        const IsoValueMapping<std::uint8_t> mapping(sphere.image, bench::kSphereIsoValue);
+        std::vector<std::array<double, 3>> points;
+        const double map = medianSeconds(reps, [&] { points = mapVertices(mesh, mapping, {}); });
+        const double build = medianSeconds(reps, [&] { toSurfaceMesh(mesh, points); });
+        const double tri = double(mesh.triangles.size());
+        std::printf("q=%-4d p=%-2d%%       %10zu %10.1f %10.1f %8.2f %10.1f %10.1f %8.2f\n", q,
+                    int(noise * 100), mesh.triangles.size(), 1e3 * track, 1e3 * loops,
+                    tri / loops / 1e6, 1e3 * map, 1e3 * build, tri / build / 1e6);
+        std::fflush(stdout);
+      }
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "bench_conversion: error: " << e.what() << "\n";
+    return 1;
+  }
+}
