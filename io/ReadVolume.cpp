@@ -347,8 +347,9 @@ AnyVolume readVolume(const std::string& path) {
 
 namespace {
 
+/// The ITK image of a volume: same voxels, spacing, origin and direction.
 template <class T>
-void writeAs(const DenseImage<T>& volume, const std::string& path) {
+typename itk::Image<T, 3>::Pointer toItkImage(const DenseImage<T>& volume) {
   using Image = itk::Image<T, 3>;
   auto image = Image::New();
   typename Image::RegionType region;
@@ -373,6 +374,13 @@ void writeAs(const DenseImage<T>& volume, const std::string& path) {
   image->SetDirection(direction);
   image->Allocate();
   std::copy(volume.data().begin(), volume.data().end(), image->GetBufferPointer());
+  return image;
+}
+
+template <class T>
+void writeAs(const DenseImage<T>& volume, const std::string& path) {
+  using Image = itk::Image<T, 3>;
+  const auto image = toItkImage(volume);
   auto writer = itk::ImageFileWriter<Image>::New();
   writer->SetFileName(path);
   writer->SetInput(image);
@@ -399,29 +407,9 @@ template <class T>
 void writeSeriesAs(const DenseImage<T>& volume, const std::string& directory) {
   using Image3 = itk::Image<T, 3>;
   using Image2 = itk::Image<T, 2>;
-  auto image = Image3::New();
-  typename Image3::RegionType region;
-  typename Image3::SizeType size;
+  const auto image = toItkImage(volume);
   const Dims& dims = volume.dims();
-  size[0] = dims.nx;
-  size[1] = dims.ny;
-  size[2] = dims.nz;
-  region.SetSize(size);
-  image->SetRegions(region);
-  image->Allocate();
-  std::copy(volume.data().begin(), volume.data().end(), image->GetBufferPointer());
   const ImageGeometry& g = volume.geometry();
-  typename Image3::SpacingType spacing;
-  typename Image3::PointType origin;
-  typename Image3::DirectionType direction;
-  for (int a = 0; a < 3; ++a) {
-    spacing[a] = g.spacing[a];
-    origin[a] = g.origin[a];
-    for (int b = 0; b < 3; ++b) direction(a, b) = g.direction[a][b];
-  }
-  image->SetSpacing(spacing);
-  image->SetOrigin(origin);
-  image->SetDirection(direction);
   auto dicom = itk::GDCMImageIO::New();
   dicom->KeepOriginalUIDOn();
   gdcm::UIDGenerator uids;
