@@ -27,10 +27,6 @@
 #include <type_traits>
 #include <vector>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include "AdjacencyPair.h"
 #include "Image.h"
 #include "Surfel.h"
@@ -75,21 +71,12 @@ class GenericRows final : public RowSource {
   int nx_;
 };
 
-/// Rows of a ThresholdImage<T> (f > s), binarised straight from the gray buffer.
+/// Rows of a ThresholdImage<T> (f > s), binarised 64 voxels at a time by ThresholdImage::row.
 template <class T>
 class ThresholdRows final : public RowSource {
  public:
   explicit ThresholdRows(const ThresholdImage<T>& image)
-      : gray_(image.gray()), dims_(image.dims()), iso_(image.isoValue()),
-        outside_(image(-1, -1, -1)) {
-    if constexpr (std::is_integral_v<T> && sizeof(T) <= 4) {
-      // For an integer f, f > s <=> f > floor(s); s below (above) the range: all 1 (all 0).
-      const double t = std::floor(iso_);
-      if (t < double(std::numeric_limits<T>::min())) mode_ = Mode::AllOnes;
-      else if (t >= double(std::numeric_limits<T>::max())) mode_ = Mode::AllZeros;
-      else threshold_ = T(t);
-    }
-  }
+      : image_(image), dims_(image.dims()), outside_(image(-1, -1, -1)) {}
 
   void fillRow(int y, int z, std::uint64_t* row) const override {
     const int nx = dims_.nx;
@@ -102,53 +89,20 @@ class ThresholdRows final : public RowSource {
         for (int x = 0; x < nx; ++x) setBit(row, x);
       return;
     }
-    const T* p = &gray_.at(0, y, z);
     std::uint64_t* out = row + kRowOffset / 64;
     int x = 0;
-    for (; x + 64 <= nx; x += 64) *out++ |= block(p + x, 64);
-    if (x < nx) *out |= block(p + x, nx - x);  // this word may hold the bit of x = nx
+    for (; x + 64 <= nx; x += 64) *out++ |= image_.row(x, y, z, 64);
+    if (x < nx) *out |= image_.row(x, y, z, nx - x);  // this word may hold the bit of x = nx
   }
 
  private:
-  enum class Mode { Compare, AllOnes, AllZeros };
-
   static void setBit(std::uint64_t* row, int x) {
     row[(x + kRowOffset) >> 6] |= std::uint64_t(1) << ((x + kRowOffset) & 63);
   }
 
-  /// Bit i is p[i] > s, for i < n <= 64.
-  std::uint64_t block(const T* p, int n) const {
-    if (mode_ == Mode::AllOnes) return n == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1;
-    if (mode_ == Mode::AllZeros) return 0;
-    std::uint64_t bits = 0;
-    int i = 0;
-    if constexpr (std::is_same_v<T, std::uint8_t>) {
-#if defined(__SSE2__)
-      // Unsigned bytes compared as signed after flipping their top bit.
-      const __m128i flip = _mm_set1_epi8(char(0x80));
-      const __m128i t = _mm_set1_epi8(char(threshold_ ^ 0x80));
-      for (; i + 16 <= n; i += 16) {
-        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + i));
-        const int mask = _mm_movemask_epi8(_mm_cmpgt_epi8(_mm_xor_si128(v, flip), t));
-        bits |= std::uint64_t(std::uint16_t(mask)) << i;
-      }
-#endif
-    }
-    for (; i < n; ++i) bits |= std::uint64_t(above(p[i])) << i;
-    return bits;
-  }
-
-  bool above(T value) const {
-    if constexpr (std::is_integral_v<T> && sizeof(T) <= 4) return value > threshold_;
-    else return double(value) > iso_;  // exactly ThresholdImage's test
-  }
-
-  const DenseImage<T>& gray_;
+  const ThresholdImage<T>& image_;
   Dims dims_;
-  double iso_;
   bool outside_;
-  Mode mode_ = Mode::Compare;
-  T threshold_{};
 };
 
 template <class Image>

@@ -16,6 +16,10 @@
 
 #include "Voxel.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace surftrack {
 
 /// Size of a domain [0, nx) x [0, ny) x [0, nz).
@@ -88,6 +92,13 @@ class ThresholdImage {
   ThresholdImage(const DenseImage<T>& image, double isoValue, bool outside = false)
       : image_(&image), iso_(isoValue), outside_(outside) {
     if (std::isnan(isoValue)) throw std::invalid_argument("iso-value is NaN");
+    if constexpr (std::is_integral_v<T> && sizeof(T) <= 4) {
+      // For an integer f, f > s <=> f > floor(s); s below (above) the range: all 1 (all 0).
+      const double t = std::floor(iso_);
+      if (t < double(std::numeric_limits<T>::lowest())) mode_ = Mode::AllOnes;
+      else if (t >= double(std::numeric_limits<T>::max())) mode_ = Mode::AllZeros;
+      else threshold_ = T(t);
+    }
   }
   bool operator()(int x, int y, int z) const {
     if (!image_->dims().contains(x, y, z)) return outside_;
@@ -96,36 +107,55 @@ class ThresholdImage {
   bool operator()(Voxel v) const { return (*this)(v.x, v.y, v.z); }
   const Dims& dims() const { return image_->dims(); }
   const DenseImage<T>& gray() const { return *image_; }
-
-  /// Values of the `count` <= 32 voxels (x0 + i, y, z) as bits i: a fast path for caches that
-  /// binarise whole rows.
-  std::uint32_t row(int x0, int y, int z, int count) const {
-    const Dims& d = image_->dims();
-    if (y < 0 || z < 0 || y >= d.ny || z >= d.nz || x0 >= d.nx || x0 + count <= 0)
-      return outside_ ? (count >= 32 ? ~0u : (1u << count) - 1u) : 0u;
-    std::uint32_t bits = 0;
-    const int lo = x0 < 0 ? -x0 : 0, hi = x0 + count > d.nx ? d.nx - x0 : count;
-    if (outside_) bits = (count >= 32 ? ~0u : (1u << count) - 1u) & ~(((1u << (hi - lo)) - 1u) << lo);
-    const T* values = &image_->at(x0 + lo, y, z) - lo;
-    if constexpr (std::is_integral_v<T>) {
-      // f > s  <=>  f > floor(s) for integers; compare in the value type, outside its range
-      // the answer is the same for every value.
-      const double floorIso = std::floor(iso_);
-      if (floorIso < double(std::numeric_limits<T>::lowest())) return bits | (((1u << (hi - lo)) - 1u) << lo);
-      if (floorIso >= double(std::numeric_limits<T>::max())) return bits;
-      const T threshold = T(floorIso);
-      for (int i = lo; i < hi; ++i) bits |= std::uint32_t(values[i] > threshold) << i;
-    } else {
-      for (int i = lo; i < hi; ++i) bits |= std::uint32_t(double(values[i]) > iso_) << i;
-    }
-    return bits;
-  }
   double isoValue() const { return iso_; }
 
+  /// Values of the `count` <= 64 voxels (x0 + i, y, z) as bits i: the fast path of the
+  /// scanner and of the tracker's brick cache, which binarise whole rows.
+  std::uint64_t row(int x0, int y, int z, int count) const {
+    const Dims& d = image_->dims();
+    const std::uint64_t all = lowBits(count);
+    if (y < 0 || z < 0 || y >= d.ny || z >= d.nz || x0 >= d.nx || x0 + count <= 0)
+      return outside_ ? all : 0;
+    const int lo = x0 < 0 ? -x0 : 0, hi = x0 + count > d.nx ? d.nx - x0 : count;
+    const std::uint64_t bits = outside_ ? all & ~(lowBits(hi - lo) << lo) : 0;
+    return bits | (compare(&image_->at(x0 + lo, y, z), hi - lo) << lo);
+  }
+
  private:
+  enum class Mode { Compare, AllOnes, AllZeros };
+
+  static std::uint64_t lowBits(int n) { return n >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1; }
+
+  /// Bit i is values[i] > s, for i < n <= 64 — exactly operator()'s test.
+  std::uint64_t compare(const T* values, int n) const {
+    if (mode_ == Mode::AllOnes) return lowBits(n);
+    if (mode_ == Mode::AllZeros) return 0;
+    std::uint64_t bits = 0;
+    int i = 0;
+    if constexpr (std::is_same_v<T, std::uint8_t>) {
+#if defined(__SSE2__)
+      // Unsigned bytes compared as signed after flipping their top bit, 16 at a time.
+      const __m128i flip = _mm_set1_epi8(char(0x80));
+      const __m128i t = _mm_set1_epi8(char(threshold_ ^ 0x80));
+      for (; i + 16 <= n; i += 16) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(values + i));
+        const int mask = _mm_movemask_epi8(_mm_cmpgt_epi8(_mm_xor_si128(v, flip), t));
+        bits |= std::uint64_t(std::uint16_t(mask)) << i;
+      }
+#endif
+    }
+    if constexpr (std::is_integral_v<T> && sizeof(T) <= 4)
+      for (; i < n; ++i) bits |= std::uint64_t(values[i] > threshold_) << i;
+    else
+      for (; i < n; ++i) bits |= std::uint64_t(double(values[i]) > iso_) << i;
+    return bits;
+  }
+
   const DenseImage<T>* image_;
   double iso_;
   bool outside_;
+  Mode mode_ = Mode::Compare;
+  T threshold_{};
 };
 
 /// Binary image of a label image: f(v) = L is a 1-voxel.
