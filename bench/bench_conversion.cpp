@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchSupport.h"
 #include "BoundaryMapping.h"
 #include "LoopExtraction.h"
 #include "SphereImage.h"
@@ -19,22 +20,6 @@
 #include "TrackComponent.h"
 
 using namespace surftrack;
-
-namespace {
-
-template <class F>
-double medianSeconds(int reps, F&& f) {
-  std::vector<double> t;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   try {
@@ -48,9 +33,7 @@ int main(int argc, char** argv) {
         return argv[++i];
       };
       if (a == "--sizes") {
-        sizes.clear();
-        std::stringstream ss(value());
-        for (std::string item; std::getline(ss, item, ',');) sizes.push_back(std::stoi(item));
+        sizes = bench::parseList<int>(value(), "size");
       } else if (a == "--reps") {
         reps = std::stoi(value());
       } else if (a == "--pair") {
@@ -69,13 +52,13 @@ int main(int argc, char** argv) {
         const auto image = sphere.binary();
         const Surfel seed = bench::protocolSeed(sphere);
         SurfaceGraph graph;
-        const double track = medianSeconds(reps, [&] { graph = trackComponent(image, seed, pair); });
+        const double track = bench::medianSeconds(reps, [&] { graph = trackComponent(image, seed, pair); });
         TriangleMesh mesh;
-        const double loops = medianSeconds(reps, [&] { mesh = extractLoops(image, graph); });
+        const double loops = bench::medianSeconds(reps, [&] { mesh = extractLoops(image, graph); });
         const IsoValueMapping<std::uint8_t> mapping(sphere.image, bench::kSphereIsoValue);
         std::vector<std::array<double, 3>> points;
-        const double map = medianSeconds(reps, [&] { points = mapVertices(mesh, mapping, {}); });
-        const double build = medianSeconds(reps, [&] { toSurfaceMesh(mesh, points); });
+        const double map = bench::medianSeconds(reps, [&] { points = mapVertices(mesh, mapping, {}); });
+        const double build = bench::medianSeconds(reps, [&] { toSurfaceMesh(mesh, points); });
         const double tri = double(mesh.triangles.size());
         std::printf("q=%-4d p=%-2d%%       %10zu %10.1f %10.1f %8.2f %10.1f %10.1f %8.2f\n", q,
                     int(noise * 100), mesh.triangles.size(), 1e3 * track, 1e3 * loops,

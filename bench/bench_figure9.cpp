@@ -46,6 +46,7 @@
 #include "BoundaryMapping.h"
 #include "LoopExtraction.h"
 #include "ScanIsoSurface.h"
+#include "BenchSupport.h"
 #include "SphereImage.h"
 #include "SurfaceMesh.h"
 #include "TrackComponent.h"
@@ -93,20 +94,11 @@ struct Options {
 
 template <class T>
 std::vector<T> parseList(const std::string& text, const char* what) {
-  std::vector<T> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) {
-    try {
-      std::size_t used = 0;
-      const double v = std::stod(item, &used);
-      if (used != item.size()) throw std::invalid_argument(item);
-      out.push_back(T(v));
-    } catch (const std::exception&) {
-      usage(std::string("bad ") + what + " '" + item + "'");
-    }
+  try {
+    return bench::parseList<T>(text, what);
+  } catch (const std::invalid_argument& e) {
+    usage(e.what());
   }
-  if (out.empty()) usage(std::string("empty ") + what + " list");
-  return out;
 }
 
 Options parse(int argc, char** argv) {
@@ -162,11 +154,7 @@ struct Instant {
   double cpu;  // seconds of this thread's CPU time
 };
 
-Instant now() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return {std::chrono::steady_clock::now(), double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec)};
-}
+Instant now() { return {std::chrono::steady_clock::now(), bench::threadCpuSeconds()}; }
 
 /// Milliseconds of wall and CPU time between two instants.
 struct Span {
@@ -185,14 +173,8 @@ struct Samples {
     wall.push_back(s.wall);
     cpu.push_back(s.cpu);
   }
-  static double median(std::vector<double> v) {
-    if (v.empty()) return NAN;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  }
-  double wallMs() const { return median(wall); }
-  double cpuMs() const { return median(cpu); }
+  double wallMs() const { return bench::median(wall); }
+  double cpuMs() const { return bench::median(cpu); }
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -24,6 +24,7 @@
 #include "ConfigurationTable.h"
 #include "DigitalCube.h"
 #include "ScanIsoSurface.h"
+#include "BenchSupport.h"
 #include "SphereImage.h"
 
 using namespace surftrack;
@@ -39,14 +40,6 @@ struct Options {
   bool cpuTime = false;
 };
 
-template <class T>
-std::vector<T> parseList(const std::string& text) {
-  std::vector<T> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) out.push_back(T(std::stod(item)));
-  return out;
-}
-
 Options parse(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
@@ -59,8 +52,8 @@ Options parse(int argc, char** argv) {
       return argv[++i];
     };
     if (a == "--runs") o.runs = std::max(1, std::atoi(value().c_str()));
-    else if (a == "--q") o.sides = parseList<int>(value());
-    else if (a == "--noise") o.noises = parseList<double>(value());
+    else if (a == "--q") o.sides = bench::parseList<int>(value(), "size");
+    else if (a == "--noise") o.noises = bench::parseList<double>(value(), "noise level");
     else if (a == "--pair") o.pair = parseAdjacencyPair(value());
     else if (a == "--no-generic") o.generic = false;
     else if (a == "--cpu-time") o.cpuTime = true;
@@ -72,30 +65,6 @@ Options parse(int argc, char** argv) {
     }
   }
   return o;
-}
-
-bool useCpuTime = false;
-
-double now() {
-  if (useCpuTime) {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-  }
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-/// Median time in seconds of `runs` calls of f; each result (a mesh) is destroyed untimed.
-template <class F>
-double medianSeconds(int runs, F&& f) {
-  std::vector<double> times;
-  for (int r = 0; r < runs; ++r) {
-    const double start = now();
-    const auto result = f();
-    times.push_back(now() - start);
-  }
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
 }
 
 /// Classic table-driven marching cubes, for comparison: reads the 8 gray values of every cube of
@@ -172,9 +141,9 @@ class ClassicMarchingCubes {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   const Options o = parse(argc, argv);
-  useCpuTime = o.cpuTime;
+  const auto clock = o.cpuTime ? bench::threadCpuSeconds : bench::wallSeconds;
   std::printf("scanning method (method 1), pair %s, median %s of %d runs, one thread\n",
               toString(o.pair).c_str(), o.cpuTime ? "thread CPU time" : "wall time", o.runs);
   std::printf("%5s %6s %10s %10s %7s | %9s %12s | %9s %12s | %9s %12s | %9s\n", "q", "noise",
@@ -194,24 +163,27 @@ int main(int argc, char** argv) {
         triangles = mesh.triangles.size();
         meshComponents(mesh, components);
       }
-      const double scan = medianSeconds(o.runs, [&] { return scanIsoSurface(image, o.pair); });
-      const double generic = o.generic ? medianSeconds(o.runs, [&] {
+      const double scan = bench::medianSeconds(o.runs, [&] { return scanIsoSurface(image, o.pair); }, clock);
+      const double generic = o.generic ? bench::medianSeconds(o.runs, [&] {
         return scanIsoSurfaceGeneric(image, o.pair);
-      }) : 0.0;
+      }, clock) : 0.0;
       const ClassicMarchingCubes classic(sphere.image, std::uint8_t(bench::kSphereIsoValue));
       {
         const TriangleMesh check = classic.run(o.pair);
         if (check.triangles.size() != triangles || check.surfels.size() != surfels)
           std::fprintf(stderr, "classic marching cubes gives another mesh!\n");
       }
-      const double mc = medianSeconds(o.runs, [&] { return classic.run(o.pair); });
-      const double oneB = medianSeconds(o.runs, [&] {
+      const double mc = bench::medianSeconds(o.runs, [&] { return classic.run(o.pair); }, clock);
+      const double oneB = bench::medianSeconds(o.runs, [&] {
         return extractComponent(scanIsoSurface(image, o.pair), seed);
-      });
+      }, clock);
       std::printf("%5d %5.0f%% %10zu %10zu %7zu | %9.2f %12.4g | %9.2f %12.4g | %9.2f %12.4g | %9.2f\n",
                   q, 100 * noise, surfels, triangles, components, 1e3 * scan, voxels / scan,
                   1e3 * generic, o.generic ? voxels / generic : 0.0, 1e3 * mc, voxels / mc, 1e3 * oneB);
       std::fflush(stdout);
     }
   return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "bench_scanning: error: %s\n", e.what());
+  return 2;
 }

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchSupport.h"
 #include "FindSeed.h"
 #include "SphereImage.h"
 #include "TrackComponent.h"
@@ -27,12 +28,6 @@
 using namespace surftrack;
 
 namespace {
-
-double threadSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
 
 long residentKiB() {
   std::ifstream statm("/proc/self/statm");
@@ -47,11 +42,6 @@ struct Measurement {
   long peakKiB = 0;                        // tracker's peak memory
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 // Runs `track` `reps` times in a child process; the child sends back its figures on a pipe.
 template <class Track>
 Measurement measure(int reps, const Track& track) {
@@ -65,14 +55,14 @@ Measurement measure(int reps, const Track& track) {
     std::size_t surfels = 0;
     for (int r = 0; r < reps; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
-      const double c0 = threadSeconds();
+      const double c0 = bench::threadCpuSeconds();
       surfels = track();
-      cpu.push_back(threadSeconds() - c0);
+      cpu.push_back(bench::threadCpuSeconds() - c0);
       wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
-    Measurement m{surfels, median(wall), median(cpu), usage.ru_maxrss - before};
+    Measurement m{surfels, bench::median(wall), bench::median(cpu), usage.ru_maxrss - before};
     if (write(fds[1], &m, sizeof m) != sizeof m) _exit(1);
     _exit(0);
   }
@@ -85,13 +75,6 @@ Measurement measure(int reps, const Track& track) {
   if (!ok || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
     throw std::runtime_error("measurement child failed");
   return m;
-}
-
-std::vector<int> parseList(const std::string& text) {
-  std::vector<int> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stoi(item));
-  return out;
 }
 
 void printRow(const std::string& name, const Measurement& m) {
@@ -116,7 +99,7 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
         return argv[++i];
       };
-      if (a == "--sizes") sizes = parseList(value());
+      if (a == "--sizes") sizes = bench::parseList<int>(value(), "size");
       else if (a == "--quick") sizes = {64, 128, 256}, reps = 3, implicitBall = false;
       else if (a == "--reps") reps = std::stoi(value());
       else if (a == "--pair") pair = parseAdjacencyPair(value());

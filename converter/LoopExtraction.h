@@ -124,7 +124,7 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
       const std::uint8_t config = cube::configurationAt(around, m);
       const CubeTriangulation& table = configurationTable(graph.pair, config);
       const int edge = cube::edgeOf(m, t);
-      const int patch = table.patchOfEdge[edge];
+      const int patch = edge < 0 ? -1 : table.patchOfEdge[edge];  // edge >= 0: m is one of t's cubes
       if (patch < 0 || cube::surfelOnEdge(m, edge, config) != t) detail::throwUnreachable(t, m, edge);
 
       // A loop of l surfels has l - 2 triangles; anything else is the strict-26 tube.

@@ -25,6 +25,8 @@
 #include "VoxelComponents.h"
 
 using namespace surftrack;
+using surftrack::testing::randomVolume;
+using surftrack::testing::sortedKeys;
 
 namespace {
 
@@ -45,14 +47,6 @@ std::vector<Triple> triangleTriples(const TriangleMesh& mesh) {
     out.push_back(normalised({mesh.surfels[t[0]].key(), mesh.surfels[t[1]].key(), mesh.surfels[t[2]].key()}));
   std::sort(out.begin(), out.end());
   return out;
-}
-
-Keys sortedKeys(const std::vector<Surfel>& surfels) {
-  Keys k;
-  k.reserve(surfels.size());
-  for (const Surfel& s : surfels) k.push_back(s.key());
-  std::sort(k.begin(), k.end());
-  return k;
 }
 
 /// Naive independent reference: every cube with min corner in [-1, n-1]^3, configurationAt,
@@ -76,14 +70,6 @@ std::vector<Triple> referenceTriples(const BinaryImage& image, AdjacencyPair pai
   return out;
 }
 
-/// A random 0/1 volume with the given density of 1-voxels (deterministic for a seed).
-BinaryVolume randomVolume(Dims dims, double density, std::uint64_t seed) {
-  BinaryVolume v(dims);
-  std::mt19937_64 rng(seed);
-  for (auto& b : v.data()) b = double(rng() >> 11) * 0x1p-53 < density;
-  return v;
-}
-
 /// The 1,000+ random images of the brief: sides 3..16 (not necessarily cubic), density 0.1..0.9.
 std::vector<BinaryVolume> randomImages(int count, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -91,7 +77,7 @@ std::vector<BinaryVolume> randomImages(int count, std::uint64_t seed) {
   for (int i = 0; i < count; ++i) {
     const Dims d{3 + int(rng() % 14), 3 + int(rng() % 14), 3 + int(rng() % 14)};
     const double density = 0.1 + 0.8 * double(rng() >> 11) * 0x1p-53;
-    out.push_back(randomVolume(d, density, rng()));
+    out.push_back(randomVolume(d, density, std::uint32_t(rng())));
   }
   return out;
 }
@@ -100,11 +86,7 @@ std::vector<BinaryVolume> randomImages(int count, std::uint64_t seed) {
 std::vector<BinaryVolume> allImages(Dims dims) {
   const int n = int(dims.count());
   std::vector<BinaryVolume> out;
-  for (int bits = 0; bits < (1 << n); ++bits) {
-    BinaryVolume v(dims);
-    for (int i = 0; i < n; ++i) v.data()[i] = (bits >> i) & 1;
-    out.push_back(std::move(v));
-  }
+  for (int bits = 0; bits < (1 << n); ++bits) out.push_back(surftrack::testing::volumeFromBits(dims, bits));
   return out;
 }
 

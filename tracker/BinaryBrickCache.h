@@ -75,10 +75,6 @@ class BinaryBrickCache {
     return Voxel{g(key), g(key >> 21), g(key >> 42)};
   }
 
-  std::size_t brickCount() const { return bricks_.size(); }
-  std::size_t bytes() const {
-    return bricks_.capacity() * sizeof(Brick) + slots_.capacity() * sizeof(Slot);
-  }
 
  private:
   // Voxels 8b-1 .. 8b+8 on each axis: rows[z][y] bit x is voxel (8bx-1+x, 8by-1+y, 8bz-1+z).

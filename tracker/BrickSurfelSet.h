@@ -60,9 +60,6 @@ class BrickSurfelSet {
           f(b, w * 64 + std::countr_zero(bits));
   }
 
-  std::size_t bytes() const {
-    return words_.capacity() * sizeof(Words) + prefix_.capacity() * sizeof(Prefix);
-  }
 
  private:
   using Words = std::array<std::uint64_t, kWords>;
