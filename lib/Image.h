@@ -19,6 +19,9 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace surftrack {
 
@@ -50,6 +53,20 @@ struct ImageGeometry {
   }
 };
 
+/// Asks Linux to back a large buffer, before it is first written, with 2 MiB pages. The tracker
+/// reads a dense volume brick by brick, ten z-slices at a time: with 4 KiB pages nearly every
+/// row of a brick is a TLB miss on volumes of a few hundred MiB. Harmless where unsupported.
+inline void adviseHugePages(void* data, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kHuge = std::uintptr_t(1) << 21;
+  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)data, (void)bytes;
+#endif
+}
+
 /// A dense volume of scalars (uint8, int16, uint16, int32, float, double, ...), x fastest.
 template <class T>
 class DenseImage {
@@ -60,6 +77,8 @@ class DenseImage {
   explicit DenseImage(Dims dims, T fill = T{}, ImageGeometry geometry = {})
       : dims_(dims), geometry_(geometry) {
     if (dims.empty()) throw std::invalid_argument("image dimensions must be positive");
+    data_.reserve(dims.count());
+    adviseHugePages(data_.data(), dims.count() * sizeof(T));
     data_.assign(dims.count(), fill);
   }
 
@@ -109,6 +128,37 @@ class ThresholdImage {
   const DenseImage<T>& gray() const { return *image_; }
   double isoValue() const { return iso_; }
 
+  /// row(x0, y0 + j, z0 + k, width) into out[k * ny + j] for a block of nz x ny rows, width <= 16:
+  /// the tracker's bricks. Inside the image, uint8 rows take one vector compare each and no
+  /// bounds checks; elsewhere, row by row.
+  void rows(int x0, int y0, int z0, int width, int ny, int nz, std::uint16_t* out) const {
+#if defined(__SSE2__)
+    if constexpr (std::is_same_v<T, std::uint8_t>) {
+      const Dims& d = image_->dims();
+      // Loads of 16 may run into the next row (masked off), never past the data.
+      if (mode_ == Mode::Compare && x0 >= 0 && y0 >= 0 && z0 >= 0 && x0 + width <= d.nx &&
+          y0 + ny <= d.ny && z0 + nz <= d.nz &&
+          image_->index(x0, y0 + ny - 1, z0 + nz - 1) + 16 <= image_->data().size()) {
+        const __m128i flip = _mm_set1_epi8(char(0x80));
+        const __m128i t = _mm_set1_epi8(char(threshold_ ^ 0x80));
+        const int keep = (1 << width) - 1;
+        const std::size_t sliceStep = std::size_t(d.nx) * std::size_t(d.ny);
+        const T* slice = &image_->at(x0, y0, z0);
+        for (int k = 0; k < nz; ++k, slice += sliceStep) {
+          const T* row = slice;
+          for (int j = 0; j < ny; ++j, row += d.nx) {
+            const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
+            *out++ = std::uint16_t(_mm_movemask_epi8(_mm_cmpgt_epi8(_mm_xor_si128(v, flip), t)) & keep);
+          }
+        }
+        return;
+      }
+    }
+#endif
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j) *out++ = std::uint16_t(row(x0, y0 + j, z0 + k, width));
+  }
+
   /// Values of the `count` <= 64 voxels (x0 + i, y, z) as bits i: the fast path of the
   /// scanner and of the tracker's brick cache, which binarise whole rows.
   std::uint64_t row(int x0, int y, int z, int count) const {
@@ -118,7 +168,8 @@ class ThresholdImage {
       return outside_ ? all : 0;
     const int lo = x0 < 0 ? -x0 : 0, hi = x0 + count > d.nx ? d.nx - x0 : count;
     const std::uint64_t bits = outside_ ? all & ~(lowBits(hi - lo) << lo) : 0;
-    return bits | (compare(&image_->at(x0 + lo, y, z), hi - lo) << lo);
+    const std::size_t first = image_->index(x0 + lo, y, z);
+    return bits | (compare(&image_->data()[first], hi - lo, image_->data().size() - first) << lo);
   }
 
  private:
@@ -126,8 +177,10 @@ class ThresholdImage {
 
   static std::uint64_t lowBits(int n) { return n >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1; }
 
-  /// Bit i is values[i] > s, for i < n <= 64 — exactly operator()'s test.
-  std::uint64_t compare(const T* values, int n) const {
+  /// Bit i is values[i] > s, for i < n <= 64 — exactly operator()'s test. `readable` values
+  /// from `values` on belong to the image: vector loads may go past n, never past those.
+  std::uint64_t compare(const T* values, int n, std::size_t readable) const {
+    (void)readable;
     if (mode_ == Mode::AllOnes) return lowBits(n);
     if (mode_ == Mode::AllZeros) return 0;
     std::uint64_t bits = 0;
@@ -137,11 +190,14 @@ class ThresholdImage {
       // Unsigned bytes compared as signed after flipping their top bit, 16 at a time.
       const __m128i flip = _mm_set1_epi8(char(0x80));
       const __m128i t = _mm_set1_epi8(char(threshold_ ^ 0x80));
-      for (; i + 16 <= n; i += 16) {
+      // A row shorter than 16 (the tracker's bricks read 10) still takes one load when the
+      // image has 16 bytes there; the bits past n are cleared below.
+      for (; i < n && std::size_t(i) + 16 <= readable; i += 16) {
         const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(values + i));
         const int mask = _mm_movemask_epi8(_mm_cmpgt_epi8(_mm_xor_si128(v, flip), t));
         bits |= std::uint64_t(std::uint16_t(mask)) << i;
       }
+      if (i >= n) return bits & lowBits(n);
 #endif
     }
     if constexpr (std::is_integral_v<T> && sizeof(T) <= 4)

@@ -153,3 +153,61 @@ TEST(BetaNeighbourTable, AgreesWithDefinition38OnEveryNeighbourhood) {
 }
 
 }  // namespace
+
+#include "TrackComponent.h"
+
+namespace {
+
+// A brick cache that answers one fixed neighbourhood and names each linked brick by its selector.
+struct FixedNeighbourhood {
+  NeighbourhoodSlices slices;
+  NeighbourhoodSlices neighbourhoodSlices(std::uint32_t, int) const { return slices; }
+  std::uint32_t linkedBrick(std::uint32_t, int selector) const { return std::uint32_t(selector); }
+};
+
+TEST(BrickStepTable, TrackerStepsAgreeWithDefinition38AtEveryPlaceOfABrick) {
+  // The tracker's moves between brick slots (deltaSlot inside the brick, a linked brick across
+  // its border, the strict-26 candidates filter) must give the reference neighbours, in order,
+  // for every pattern of the 16 voxels around a surfel and for voxels on every kind of border.
+  const Voxel places[] = {{0, 0, 0}, {7, 7, 7}, {3, 0, 7}, {7, 4, 0}, {2, 5, 3}, {0, 7, 4}};
+  for (AdjacencyPair pair : kAllAdjacencyPairs) {
+    const BrickStepTable steps(pair);
+    for (Direction n = 0; n < 6; ++n) {
+      const Voxel u{0, 0, 0}, un = unitVector(n);
+      std::vector<int> relevant;
+      for (int b = 0; b < 27; ++b) {
+        const Voxel d{b % 3 - 1, (b / 3) % 3 - 1, b / 9 - 1};
+        const bool inSlab = d[axisOf(n)] == 0 || d[axisOf(n)] == signOf(n);
+        if (inSlab && d != u && d != un) relevant.push_back(b);
+      }
+      ASSERT_EQ(relevant.size(), 16u);
+      for (const Voxel& place : places) {
+        const Surfel t{Voxel{40, -9, 13} + place, n};
+        const int slot = brickslot::slotOf(brickslot::voxelOf(place.x, place.y, place.z), n);
+        for (std::uint32_t pattern = 0; pattern < (1u << 16); ++pattern) {
+          std::uint32_t bits = 1u << Neighbourhood::bitOf(u);
+          for (int i = 0; i < 16; ++i)
+            if ((pattern >> i) & 1) bits |= 1u << relevant[i];
+          Surfel expected[kMaxBetaNeighbours];
+          const int k = betaNeighbours(Neighbourhood{t.c, bits}, t, pair, expected);
+          FixedNeighbourhood cache{{{bits & 511u, (bits >> 9) & 511u, bits >> 18}}};
+          std::vector<Surfel> found;
+          detail::forEachBetaNeighbour(
+              cache, steps, 13, slot,
+              [&](std::uint32_t brick, int to) {
+                const int s = int(brick), v = to & 511;
+                const Voxel local{v & 7, (v >> 3) & 7, v >> 6};
+                const Voxel offset{8 * (s % 3 - 1), 8 * ((s / 3) % 3 - 1), 8 * (s / 9 - 1)};
+                found.push_back(Surfel{t.c + offset + local - place, Direction(to >> 9)});
+              },
+              [] {});
+          ASSERT_EQ(int(found.size()), k) << toString(pair) << " pattern " << pattern;
+          for (int j = 0; j < k; ++j)
+            ASSERT_EQ(found[j], expected[j]) << toString(pair) << " pattern " << pattern << " place " << place;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace

@@ -83,17 +83,27 @@ class BetaNeighbourTable {
     return count;
   }
 
- private:
+  /// The rule across one edge of a surfel with normal n (spec.md §2's table).
   struct EdgeRule {
     std::uint8_t aBit = 0, bBit = 0;  // neighbourhood bits of u+e and u+n+e
     std::array<Surfel, 4> result{};   // neighbour relative to u, by a | b << 1
   };
+  /// Rule (iv) in one of the 4 cubes around a surfel's edge: its two strict-26 links.
   struct CubeRule {
     std::uint32_t mask = 0;         // the 6 corners other than u and u+n
     std::uint32_t strictOnes = 0;   // strict 26-configuration of 1-voxels
     std::uint32_t strictZeros = 0;  // strict 26-configuration of 0-voxels
-    std::array<std::array<Surfel, 2>, 2> links{};
+    std::array<std::array<Surfel, 2>, 2> links{};  // [0]: of 1-voxels, [1]: of 0-voxels
   };
+
+  bool kappa26() const { return kappa26_; }
+  bool lambda26() const { return lambda26_; }
+  /// Edge rule k (by increasing Direction code of e) of a surfel with normal n.
+  const EdgeRule& edgeRule(Direction n, int k) const { return edges_[n][k]; }
+  /// Cube rule q (the order of betaNeighbours) of a surfel with normal n.
+  const CubeRule& cubeRule(Direction n, int q) const { return cubes_[n][q]; }
+
+ private:
   bool kappa26_, lambda26_;
   std::array<std::array<EdgeRule, 4>, 6> edges_{};
   std::array<std::array<CubeRule, 4>, 6> cubes_{};

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "Hash.h"
@@ -27,6 +28,11 @@ struct Neighbourhood {
   bool operator()(int x, int y, int z) const { return (*this)(Voxel{x, y, z}); }
 };
 
+/// The 3x3x3 neighbourhood as three 9-bit z-slices, dz = -1, 0, +1.
+struct NeighbourhoodSlices {
+  std::uint32_t bits[3];
+};
+
 template <class BinaryImage>
 class BinaryBrickCache {
  public:
@@ -37,14 +43,49 @@ class BinaryBrickCache {
 
   /// The same, when u's brick index is already known.
   Neighbourhood neighbourhood(std::uint32_t brick, Voxel u) const {
-    const Brick& b = bricks_[brick];
-    const int lx = u.x & 7, ly = u.y & 7, lz = u.z & 7;  // apron coordinates of u - (1,1,1)
-    std::uint32_t bits = 0;
-    int shift = 0;
-    for (int z = lz; z <= lz + 2; ++z)
-      for (int y = ly; y <= ly + 2; ++y, shift += 3) bits |= ((b.rows[z][y] >> lx) & 7u) << shift;
-    return Neighbourhood{u, bits};
+    return Neighbourhood{u, neighbourhoodBits(brick, u.x & 7, u.y & 7, u.z & 7)};
   }
+
+  /// Neighbourhood::bits of the voxel at (lx, ly, lz) in [0, 8)^3 of the brick: three 64-bit
+  /// loads, each bringing the 3 apron rows y .. y+2 of one z-slice.
+  std::uint32_t neighbourhoodBits(std::uint32_t brick, int lx, int ly, int lz) const {
+    return neighbourhoodBits(brick, lx + 8 * ly + 64 * lz);
+  }
+  /// The same for voxel index x + 8y + 64z of the brick.
+  std::uint32_t neighbourhoodBits(std::uint32_t brick, int voxel) const {
+    const NeighbourhoodSlices s = neighbourhoodSlices(brick, voxel);
+    return s.bits[0] | s.bits[1] << 9 | s.bits[2] << 18;
+  }
+
+  /// The neighbourhood as its three z-slices of 9 bits (Neighbourhood::bits = s0 | s1 << 9 |
+  /// s2 << 18): three 64-bit loads, each bringing the apron rows y .. y+2 of one slice.
+  NeighbourhoodSlices neighbourhoodSlices(std::uint32_t brick, int voxel) const {
+    const Brick& b = bricks_[brick];
+    const int lx = voxel & 7, ly = (voxel >> 3) & 7, lz = voxel >> 6;
+    NeighbourhoodSlices s;
+    for (int dz = 0; dz < 3; ++dz) {
+      std::uint64_t w;
+      std::memcpy(&w, &b.rows[lz + dz][ly], sizeof w);  // rows y, y+1, y+2 (and one spare)
+      const std::uint64_t t = (w >> lx) & 0x0000000700070007ull;
+      s.bits[dz] = std::uint32_t((t | t >> 13 | t >> 26) & 0x1FFu);
+    }
+    return s;
+  }
+
+  /// The brick next to brick b at offset (sx-1, sy-1, sz-1), selector s = sx + 3 sy + 9 sz in
+  /// [0, 27) (13 is b itself); created on first use. Links are remembered both ways, so the
+  /// tracker hashes a brick key about once per brick face it crosses.
+  std::uint32_t linkedBrick(std::uint32_t b, int s) {
+    std::uint32_t l = links_[b][s];
+    if (l != kNoLink) return l;
+    const Voxel o = brickOrigin(b);
+    l = brickIndex((o.x >> 3) + s % 3 - 1, (o.y >> 3) + (s / 3) % 3 - 1, (o.z >> 3) + s / 9 - 1);
+    links_[b][s] = l;
+    links_[l][26 - s] = b;
+    return l;
+  }
+
+  std::size_t brickCount() const { return bricks_.size(); }
 
   /// The index of the brick that contains voxel v.
   std::uint32_t brickOf(Voxel v) { return brickIndex(v.x >> 3, v.y >> 3, v.z >> 3); }
@@ -65,6 +106,8 @@ class BinaryBrickCache {
     }
     slots_[i] = {key, std::uint32_t(bricks_.size())};
     bricks_.push_back(binarise(key, bx, by, bz));
+    links_.emplace_back().fill(kNoLink);
+    links_.back()[13] = std::uint32_t(bricks_.size() - 1);
     return remember(recent, key, std::uint32_t(bricks_.size() - 1));
   }
 
@@ -81,6 +124,7 @@ class BinaryBrickCache {
   struct Brick {
     std::uint64_t key;
     std::array<std::array<std::uint16_t, 10>, 10> rows;
+    std::uint16_t spare[3];  // read, never used, by neighbourhoodBits' last 64-bit load
   };
   struct Slot {
     std::uint64_t key;
@@ -103,18 +147,18 @@ class BinaryBrickCache {
   }
 
   Brick binarise(std::uint64_t key, int bx, int by, int bz) const {
-    Brick b{key, {}};
+    Brick b{key, {}, {}};
     const int x0 = 8 * bx - 1, y0 = 8 * by - 1, z0 = 8 * bz - 1;
-    for (int z = 0; z < 10; ++z)
-      for (int y = 0; y < 10; ++y) {
-        if constexpr (requires { image_->row(x0, y0, z0, 10); }) {
-          b.rows[z][y] = std::uint16_t(image_->row(x0, y0 + y, z0 + z, 10));
-        } else {
+    if constexpr (requires { image_->rows(x0, y0, z0, 10, 10, 10, &b.rows[0][0]); }) {
+      image_->rows(x0, y0, z0, 10, 10, 10, &b.rows[0][0]);
+    } else {
+      for (int z = 0; z < 10; ++z)
+        for (int y = 0; y < 10; ++y) {
           std::uint16_t row = 0;
           for (int x = 0; x < 10; ++x) row |= std::uint16_t((*image_)(x0 + x, y0 + y, z0 + z) << x);
           b.rows[z][y] = row;
         }
-      }
+    }
     return b;
   }
 
@@ -128,8 +172,11 @@ class BinaryBrickCache {
     }
   }
 
+  static constexpr std::uint32_t kNoLink = ~std::uint32_t(0);
+
   const BinaryImage* image_;
   std::vector<Brick> bricks_;
+  std::vector<std::array<std::uint32_t, 27>> links_;  // linkedBrick, kNoLink until first use
   std::vector<Slot> slots_;
   std::size_t mask_ = 0;
   std::array<Recent, 64> recent_;

@@ -5,6 +5,7 @@
 // with no hashing of surfels at all.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -23,9 +24,16 @@ class BrickSurfelSet {
     return n * 512 + local.z * 64 + local.y * 8 + local.x;
   }
 
-  /// Marks the surfel; false if it was already marked.
+  /// Makes room for bricks [0, count).
+  void resize(std::size_t count) {
+    if (count > words_.size()) words_.resize(std::max(count, 2 * words_.size()), Words{});
+  }
+
+  /// The 48 words of a brick made room for (invalidated by resize).
+  std::uint64_t* words(std::uint32_t brick) { return words_[brick].data(); }
+
+  /// Marks the surfel of a brick made room for; false if it was already marked.
   bool insert(std::uint32_t brick, int bit) {
-    if (brick >= words_.size()) words_.resize(brick + 1, Words{});
     std::uint64_t& w = words_[brick][bit >> 6];
     const std::uint64_t m = std::uint64_t(1) << (bit & 63);
     if (w & m) return false;

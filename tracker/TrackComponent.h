@@ -14,8 +14,9 @@
 
 #include "AdjacencyPair.h"
 #include "BetaAdjacency.h"
-#include "BetaNeighbourTable.h"
+#include "AppendBuffer.h"
 #include "BinaryBrickCache.h"
+#include "BrickStepTable.h"
 #include "Image.h"
 #include "SurfaceGraph.h"
 #include "BrickSurfelSet.h"
@@ -44,77 +45,124 @@ void requireTrackableSeed(const BinaryImage& image, const Surfel& seed) {
   requireBoundarySurfel(image, seed);
 }
 
+namespace detail {
+
+// The per-arc lambdas of the traversal must be inlined: as calls they double its cost.
+#define SURFTRACK_INLINE __attribute__((always_inline))
+
+/// Calls f(brick, slot) for each beta-neighbour of the surfel in `slot` of brick b, in the
+/// order of betaNeighbours. Neighbours in other bricks come through cache.linkedBrick, which
+/// creates (binarises) a brick on first use; `crossed` is called after that may have happened.
+template <class Cache, class F, class Crossed>
+[[gnu::always_inline]] inline void forEachBetaNeighbour(Cache& cache, const BrickStepTable& steps, std::uint32_t b,
+                                 int slot, F&& f, Crossed&& crossed) {
+  const int voxel = slot & 511;
+  const NeighbourhoodSlices slices = cache.neighbourhoodSlices(b, voxel);
+  const std::uint8_t border = brickslot::kBorderFlags[voxel];
+  const Direction n = Direction(slot >> 9);
+  auto follow = [&](const BrickStep& step) SURFTRACK_INLINE {
+    if (border & step.crossMask) [[unlikely]] {
+      const int x = (voxel & 7) + step.dx, y = ((voxel >> 3) & 7) + step.dy, z = (voxel >> 6) + step.dz;
+      const std::uint32_t brick =
+          cache.linkedBrick(b, ((x + 8) >> 3) + 3 * ((y + 8) >> 3) + 9 * ((z + 8) >> 3));
+      crossed();
+      f(brick, brickslot::slotOf(brickslot::voxelOf(x & 7, y & 7, z & 7), step.n));
+    } else {
+      f(b, slot + step.deltaSlot);
+    }
+  };
+  const int pattern = steps.edgePattern(n, slices.bits);
+  const auto& edges = steps.edges(n);
+  follow(edges[0].result[pattern & 3]);
+  follow(edges[1].result[(pattern >> 2) & 3]);
+  follow(edges[2].result[(pattern >> 4) & 3]);
+  follow(edges[3].result[pattern >> 6]);
+  // Rule (iv); strictOnes / strictZeros never match when the pair has no such links.
+  if (const std::uint8_t candidates = steps.cubeCandidates(n, pattern)) {
+    const std::uint32_t bits = slices.bits[0] | slices.bits[1] << 9 | slices.bits[2] << 18;
+    for (int q = 0; q < 4; ++q) {
+      if (!(candidates >> q & 1)) continue;
+      const auto& cube = steps.cubes(n)[q];
+      const std::uint32_t m = bits & cube.mask;
+      if (m == cube.strictOnes || m == cube.strictZeros)
+        for (const BrickStep& link : cube.links[m == cube.strictOnes ? 0 : 1]) follow(link);
+    }
+  }
+}
+
+}  // namespace detail
+
 /// The surface graph G(Sigma, beta) of the kappa-lambda-boundary Sigma containing `seed`.
-/// Vertices are numbered by position (brick by brick), not in traversal order.
+/// Vertices are numbered by position (8x8x8 brick by brick); the out-arcs of each vertex are in
+/// the order of betaNeighbours (see SurfaceGraph.h).
+///
+/// Two passes over the surface, both local to a brick and its neighbours (BrickStepTable.h):
+/// a breadth-first traversal marks the surfels of Sigma in per-brick bitmaps; then, brick by
+/// brick, each marked surfel's beta-neighbours are found again and written as vertex indices,
+/// which are ranks in the bitmaps. Recomputing a neighbour costs less than storing and
+/// re-reading it.
 template <class BinaryImage>
 SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, AdjacencyPair pair,
                             const TrackingProgress& progress = {}) {
   requireTrackableSeed(image, seed);
   BinaryBrickCache<BinaryImage> cache(image);
-  const BetaNeighbourTable beta(pair);
+  const BrickStepTable steps(pair);
   BrickSurfelSet visited;
-  struct Place {
-    std::uint32_t brick;
-    int bit;
-  };
-  // Where surfel s is marked; `near` is a voxel whose brick `nearBrick` is known (a
-  // neighbour's 1-voxel is within ±1 of the current one, most often in the same brick).
-  auto placeOf = [&cache](const Surfel& s, Voxel near, std::uint32_t nearBrick) {
-    const Voxel c = s.inside();
-    const bool sameBrick = (((c.x ^ near.x) | (c.y ^ near.y) | (c.z ^ near.z)) >> 3) == 0;
-    return Place{sameBrick ? nearBrick : cache.brickOf(c),
-                 BrickSurfelSet::bitOf(Voxel{c.x & 7, c.y & 7, c.z & 7}, s.n)};
-  };
-  Surfel neighbours[kMaxBetaNeighbours];
 
-  // 1. Breadth-first traversal of beta-arcs from the seed: marks the surfels of Sigma.
+  // 1. Breadth-first traversal of beta-arcs from the seed; queue entries are brick << 12 | slot.
+  std::size_t arcs = 0;
   {
-    std::vector<Surfel> queue{seed};
-    const Place p = placeOf(seed, seed.inside(), cache.brickOf(seed.inside()));
-    visited.insert(p.brick, p.bit);
+    AppendBuffer<std::uint64_t> queue;
+    const Voxel c = seed.inside();
+    const std::uint32_t b = cache.brickOf(c);
+    const int slot = brickslot::slotOf(brickslot::voxelOf(c.x & 7, c.y & 7, c.z & 7), seed.n);
+    visited.resize(cache.brickCount());
+    visited.insert(b, slot);
+    queue.push(std::uint64_t(b) << 12 | std::uint64_t(slot));
     for (std::size_t i = 0; i < queue.size(); ++i) {
-      const Surfel t = queue[i];
-      const std::uint32_t brick = cache.brickOf(t.inside());
-      const int count = beta.neighbours(cache.neighbourhood(brick, t.inside()).bits, t, neighbours);
-      for (int k = 0; k < count; ++k) {
-        const Place q = placeOf(neighbours[k], t.inside(), brick);
-        if (visited.insert(q.brick, q.bit)) queue.push_back(neighbours[k]);
-      }
+      queue.reserve(kMaxBetaNeighbours);
+      const std::uint32_t brick = std::uint32_t(queue[i] >> 12);
+      std::uint64_t* words = visited.words(brick);
+      detail::forEachBetaNeighbour(
+          cache, steps, brick, int(queue[i] & 4095),
+          [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE {
+            ++arcs;
+            std::uint64_t& w = to == brick ? words[toSlot >> 6] : visited.words(to)[toSlot >> 6];
+            const std::uint64_t m = std::uint64_t(1) << (toSlot & 63);
+            if (w & m) return;
+            w |= m;
+            queue.push(std::uint64_t(to) << 12 | std::uint64_t(toSlot));
+          },
+          [&] {
+            visited.resize(cache.brickCount());
+            words = visited.words(brick);
+          });
       if (progress && (i & 0xFFFFF) == 0xFFFFF) progress(queue.size());
     }
   }
 
-  // 2. Number the surfels brick by brick, so that each arc finds its target's index in O(1).
+  // 2. Vertices by rank, arcs by recomputing each vertex's neighbours.
+  const std::uint32_t count = visited.number();
   SurfaceGraph result;
   result.pair = pair;
-  result.surfels.resize(visited.number());
-  {
-    std::size_t v = 0;
-    visited.forEach([&](std::uint32_t brick, int bit) {
-      const Voxel o = cache.brickOrigin(brick);
-      const int voxel = bit & 511;
-      result.surfels[v++] = Surfel{o + Voxel{voxel & 7, (voxel >> 3) & 7, voxel >> 6},
-                                   Direction(bit >> 9)};
-    });
-  }
-
-  // 3. The arcs, in compressed sparse row form.
-  std::vector<std::uint32_t> rowStart;
-  std::vector<std::uint32_t> targets;
-  rowStart.reserve(result.surfels.size() + 1);
-  targets.reserve(4 * result.surfels.size() + 64);
-  rowStart.push_back(0);
-  for (const Surfel& t : result.surfels) {
-    const std::uint32_t brick = cache.brickOf(t.inside());
-    const int count = beta.neighbours(cache.neighbourhood(brick, t.inside()).bits, t, neighbours);
-    for (int k = 0; k < count; ++k) {
-      const Place q = placeOf(neighbours[k], t.inside(), brick);
-      targets.push_back(visited.index(q.brick, q.bit));
-    }
-    rowStart.push_back(std::uint32_t(targets.size()));
-  }
+  result.surfels.resize(count);
+  std::vector<std::uint32_t> rowStart(std::size_t(count) + 1);
+  std::vector<std::uint32_t> targets(arcs);
+  std::uint32_t v = 0, a = 0;
+  visited.forEach([&](std::uint32_t brick, int slot) {
+    const int voxel = slot & 511;
+    result.surfels[v] = Surfel{cache.brickOrigin(brick) + Voxel{voxel & 7, (voxel >> 3) & 7, voxel >> 6},
+                               Direction(slot >> 9)};
+    detail::forEachBetaNeighbour(
+        cache, steps, brick, slot,
+        [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE { targets[a++] = visited.index(to, toSlot); },
+        [] {});
+    rowStart[++v] = a;
+  });
   result.graph = makeSurfelGraph(std::move(rowStart), std::move(targets));
   return result;
 }
+
+#undef SURFTRACK_INLINE
 
 }  // namespace surftrack
