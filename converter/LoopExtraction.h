@@ -27,12 +27,31 @@ namespace surftrack {
 
 namespace detail {
 
-/// Index q of the cube with min corner m among cube::cubesOf(s) (m must contain s's edge): bit 0
-/// is set when the cube extends towards -b from s's edge, bit 1 towards -c (b < c the two axes
-/// orthogonal to s's normal).
-inline int cubeSlot(const Surfel& s, Voxel m) {
-  const auto [b, c] = cube::otherAxes(axisOf(s.n));
-  return (s.inside()[b] != m[b] ? 1 : 0) | (s.inside()[c] != m[c] ? 2 : 0);
+/// Where surfel s sits in the digital 3-cube with min corner m: its cube edge, its 1-voxel's
+/// corner, and which of s's 4 cubes m is (cube::cubesOf order). edge < 0: s is not in the cube.
+struct SurfelInCube {
+  int edge = -1;
+  int corner = 0;
+  int slot = 0;
+};
+
+inline SurfelInCube locate(const Surfel& s, Voxel m) {
+  const int d[3] = {s.c.x - m.x, s.c.y - m.y, s.c.z - m.z};
+  if (unsigned(d[0]) > 1u || unsigned(d[1]) > 1u || unsigned(d[2]) > 1u) return {};
+  const int a = axisOf(s.n);
+  // The 0-voxel c + n must be in the cube too: c is on the low face along a iff n points up.
+  if (d[a] != (signOf(s.n) > 0 ? 0 : 1)) return {};
+  const int corner = d[0] | d[1] << 1 | d[2] << 2;
+  const int b = a == 0 ? 1 : 0, c = a == 2 ? 1 : 2;  // the two other axes, b < c
+  return {cube::edgeBetween(corner, corner ^ (1 << a)), corner, d[b] | d[c] << 1};
+}
+
+/// The configuration of the cube with min corner c + offset, offset in {-1, 0}^3, from the
+/// 3x3x3 neighbourhood bits of voxel c (Neighbourhood::bitOf): its corners are the bits at
+/// bitOf(offset) + {0, 1, 3, 4, 9, 10, 12, 13}.
+inline std::uint8_t configurationFrom(std::uint32_t bits, Voxel offset) {
+  const std::uint32_t t = bits >> Neighbourhood::bitOf(offset);
+  return std::uint8_t((t & 3u) | ((t >> 3) & 3u) << 2 | ((t >> 9) & 3u) << 4 | ((t >> 12) & 3u) << 6);
 }
 
 [[noreturn]] inline void throwUnreachable(const Surfel& t, Voxel m, int edge) {
@@ -44,12 +63,12 @@ inline int cubeSlot(const Surfel& s, Voxel m) {
 
 /// The graph vertices on the cube edges of one patch of one cube.
 struct PatchVertices {
-  std::array<std::int64_t, cube::kEdges> onEdge;
-  std::array<std::uint32_t, cube::kEdges> found{};
+  std::array<std::int32_t, cube::kEdges> onEdge;
+  std::array<std::uint32_t, cube::kEdges> found;
   int count = 0;
   PatchVertices() { onEdge.fill(-1); }
   void add(int edge, std::uint32_t v) {
-    onEdge[edge] = v;
+    onEdge[edge] = std::int32_t(v);
     found[count++] = v;
   }
 };
@@ -59,17 +78,18 @@ struct PatchVertices {
 /// False if the walk does not close on the patch's cube edges.
 inline bool walkLoop(const SurfaceGraph& graph, Voxel m, std::uint8_t config, int patch,
                      const CubeTriangulation& table, std::uint32_t v, PatchVertices& out) {
+  const auto& rowStart = graph.graph.m_forward.m_rowstart;
+  const auto& column = graph.graph.m_forward.m_column;
   std::uint32_t previous = v, current = v;
   do {
     const Surfel& s = graph.surfels[current];
-    const int edge = cube::edgeOf(m, s);
-    if (edge < 0 || table.patchOfEdge[edge] != patch || out.onEdge[edge] >= 0 ||
-        cube::surfelOnEdge(m, edge, config) != s)
+    const SurfelInCube at = locate(s, m);
+    if (at.edge < 0 || table.patchOfEdge[at.edge] != patch || out.onEdge[at.edge] >= 0 ||
+        !((config >> at.corner) & 1) || ((config >> (at.corner ^ (1 << axisOf(s.n)))) & 1))
       return false;
-    out.add(edge, current);
-    const int q = cubeSlot(s, m);
-    auto arcs = boost::adjacent_vertices(current, graph.graph).first;
-    const std::uint32_t a = arcs[q & 1], b = arcs[2 + (q >> 1)];
+    out.add(at.edge, current);
+    const std::uint32_t* arcs = column.data() + rowStart[current];
+    const std::uint32_t a = arcs[at.slot & 1], b = arcs[2 + (at.slot >> 1)];
     const std::uint32_t next = (a != previous || previous == current) ? a : b;
     previous = current;
     current = next;
@@ -93,6 +113,22 @@ inline void walkPatch(const SurfaceGraph& graph, Voxel m, std::uint8_t config, i
     }
 }
 
+/// For a surfel with normal n, the min corner of each of its 4 cubes (cube::cubesOf order)
+/// minus its 1-voxel.
+inline constexpr std::array<std::array<Voxel, 4>, 6> kCubeOffsets = [] {
+  std::array<std::array<Voxel, 4>, 6> out{};
+  for (Direction n = 0; n < 6; ++n) {
+    const int a = axisOf(n), b = a == 0 ? 1 : 0, c = a == 2 ? 1 : 2;
+    for (int q = 0; q < 4; ++q) {
+      Voxel m = signOf(n) > 0 ? Voxel{} : unitVector(n);
+      m[b] -= q & 1;
+      m[c] -= (q >> 1) & 1;
+      out[n][q] = m;
+    }
+  }
+  return out;
+}();
+
 }  // namespace detail
 
 /// The kappa-lambda-continuous analog of the boundary whose surface graph is `graph`, tracked in
@@ -103,48 +139,46 @@ inline void walkPatch(const SurfaceGraph& graph, Voxel m, std::uint8_t config, i
 template <class BinaryImage>
 TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
   const std::vector<Surfel>& surfels = graph.surfels;
+  const auto tables = configurationTables(graph.pair);
   TriangleMesh mesh;
   mesh.surfels = surfels;
-  mesh.triangles.reserve(2 * surfels.size());
+  mesh.triangles.reserve(2 * surfels.size() + 16);
   // flags[v] bit q: the patch of surfel v in cube cubesOf(surfels[v])[q] has been emitted.
   std::vector<std::uint8_t> flags(surfels.size(), 0);
   // The 4 cubes around a surfel lie in the 3x3x3 neighbourhood of its 1-voxel: read them from
-  // the tracker's brick cache rather than voxel by voxel from the image.
+  // a brick cache rather than voxel by voxel from the image.
   BinaryBrickCache<BinaryImage> cache(image);
-  detail::PatchVertices patchVertices;
 
   for (std::uint32_t v = 0; v < surfels.size(); ++v) {
     if (flags[v] == 0xF) continue;
     const Surfel& t = surfels[v];
-    const std::array<Voxel, 4> cubes = cube::cubesOf(t);
-    const Neighbourhood around = cache.neighbourhood(t.inside());
+    const std::uint32_t around = cache.neighbourhood(t.inside()).bits;
     for (int q = 0; q < 4; ++q) {
       if (flags[v] & (1u << q)) continue;
-      const Voxel m = cubes[q];
-      const std::uint8_t config = cube::configurationAt(around, m);
-      const CubeTriangulation& table = configurationTable(graph.pair, config);
-      const int edge = cube::edgeOf(m, t);
-      const int patch = edge < 0 ? -1 : table.patchOfEdge[edge];  // edge >= 0: m is one of t's cubes
-      if (patch < 0 || cube::surfelOnEdge(m, edge, config) != t) detail::throwUnreachable(t, m, edge);
+      const Voxel offset = detail::kCubeOffsets[t.n][q];
+      const Voxel m = t.c + offset;
+      const std::uint8_t config = detail::configurationFrom(around, offset);
+      const CubeTriangulation& table = tables[config];
+      const int edge = detail::locate(t, m).edge;  // >= 0: m is one of t's cubes
+      const int patch = table.patchOfEdge[edge];
+      if (patch < 0) detail::throwUnreachable(t, m, edge);
 
       // A loop of l surfels has l - 2 triangles; anything else is the strict-26 tube.
       const auto triangles = table.patchTriangles(patch);
-      patchVertices = detail::PatchVertices{};
+      detail::PatchVertices patchVertices;
       if (!detail::walkLoop(graph, m, config, patch, table, v, patchVertices) ||
           std::size_t(patchVertices.count) != triangles.size() + 2)
         detail::walkPatch(graph, m, config, patch, table, v, patchVertices);
 
       for (const auto& tri : triangles) {
-        std::array<std::uint32_t, 3> out{};
-        for (int j = 0; j < 3; ++j) {
-          if (patchVertices.onEdge[tri[j]] < 0) detail::throwUnreachable(t, m, tri[j]);
-          out[j] = std::uint32_t(patchVertices.onEdge[tri[j]]);
-        }
-        mesh.triangles.push_back(out);
+        const std::int32_t a = patchVertices.onEdge[tri[0]], b = patchVertices.onEdge[tri[1]],
+                           c = patchVertices.onEdge[tri[2]];
+        if ((a | b | c) < 0) detail::throwUnreachable(t, m, a < 0 ? tri[0] : b < 0 ? tri[1] : tri[2]);
+        mesh.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
       }
       for (int i = 0; i < patchVertices.count; ++i) {
         const std::uint32_t w = patchVertices.found[i];
-        flags[w] |= std::uint8_t(1u << detail::cubeSlot(surfels[w], m));
+        flags[w] |= std::uint8_t(1u << detail::locate(surfels[w], m).slot);
       }
     }
   }

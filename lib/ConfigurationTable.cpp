@@ -17,4 +17,8 @@ const CubeTriangulation& configurationTable(AdjacencyPair pair, std::uint8_t con
   return kTables[static_cast<int>(pair)][config];
 }
 
+std::span<const CubeTriangulation, 256> configurationTables(AdjacencyPair pair) {
+  return kTables[static_cast<int>(pair)];
+}
+
 }  // namespace surftrack

@@ -49,4 +49,7 @@ struct CubeTriangulation {
 /// The precomputed table entry of `config` (bit i = value of corner i) for `pair`.
 const CubeTriangulation& configurationTable(AdjacencyPair pair, std::uint8_t config);
 
+/// All 256 entries of `pair`, indexed by configuration.
+std::span<const CubeTriangulation, 256> configurationTables(AdjacencyPair pair);
+
 }  // namespace surftrack
