@@ -19,6 +19,7 @@
 
 #include "BinaryBrickCache.h"
 #include "ConfigurationTable.h"
+#include "CubeLoops.h"
 #include "DigitalCube.h"
 #include "SurfaceGraph.h"
 #include "TriangleMesh.h"
@@ -65,36 +66,38 @@ inline std::uint8_t configurationFrom(std::uint32_t bits, Voxel offset) {
 struct PatchVertices {
   std::array<std::int32_t, cube::kEdges> onEdge;
   std::array<std::uint32_t, cube::kEdges> found;
+  std::array<std::uint8_t, cube::kEdges> edgeOfFound;
   int count = 0;
   PatchVertices() { onEdge.fill(-1); }
   void add(int edge, std::uint32_t v) {
     onEdge[edge] = std::int32_t(v);
+    edgeOfFound[count] = std::uint8_t(edge);
     found[count++] = v;
   }
 };
 
-/// A loop (§5.2): from vertex v, follow the two face arcs each surfel has inside the cube (the
-/// edge neighbours towards the cube's two faces through the surfel's edge) until back at v.
-/// False if the walk does not close on the patch's cube edges.
-inline bool walkLoop(const SurfaceGraph& graph, Voxel m, std::uint8_t config, int patch,
-                     const CubeTriangulation& table, std::uint32_t v, PatchVertices& out) {
+/// A loop (§5.2): from vertex v, around the patch's cube edges in the order of its CubeLoop,
+/// taking at each surfel the out-arc that leads to the next edge. False if the patch is no
+/// loop (the strict-26 tube), or if a vertex reached is not the surfel of its cube edge or the
+/// walk does not close: the caller then searches the patch and reports the mismatch.
+inline bool walkLoop(const SurfaceGraph& graph, Voxel m, std::uint8_t config, const CubeLoop& loop,
+                     int startEdge, std::uint32_t v, PatchVertices& out) {
+  const int length = loop.length;
+  int i = 0;
+  while (i < length && loop.edge[i] != startEdge) ++i;
+  if (i == length) return false;
   const auto& rowStart = graph.graph.m_forward.m_rowstart;
   const auto& column = graph.graph.m_forward.m_column;
-  std::uint32_t previous = v, current = v;
-  do {
-    const Surfel& s = graph.surfels[current];
-    const SurfelInCube at = locate(s, m);
-    if (at.edge < 0 || table.patchOfEdge[at.edge] != patch || out.onEdge[at.edge] >= 0 ||
-        !((config >> at.corner) & 1) || ((config >> (at.corner ^ (1 << axisOf(s.n)))) & 1))
-      return false;
-    out.add(at.edge, current);
-    const std::uint32_t* arcs = column.data() + rowStart[current];
-    const std::uint32_t a = arcs[at.slot & 1], b = arcs[2 + (at.slot >> 1)];
-    const std::uint32_t next = (a != previous || previous == current) ? a : b;
-    previous = current;
-    current = next;
-  } while (current != v && out.count < cube::kEdges);
-  return current == v;
+  std::uint32_t current = v;
+  bool matches = true;
+  for (int step = 0; step < length; ++step, i = i + 1 == length ? 0 : i + 1) {
+    const int k = loop.edge[i];
+    const EdgeSurfel& expected = edgeSurfel(config, k);
+    matches &= graph.surfels[current] == Surfel{m + expected.inside, expected.n};
+    out.add(k, current);
+    current = column[rowStart[current] + loop.arc[i]];
+  }
+  return matches && current == v;
 }
 
 /// Any patch, the strict-26 tube included: breadth-first over all arcs that stay on the patch's
@@ -163,11 +166,9 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
       const int patch = table.patchOfEdge[edge];
       if (patch < 0) detail::throwUnreachable(t, m, edge);
 
-      // A loop of l surfels has l - 2 triangles; anything else is the strict-26 tube.
       const auto triangles = table.patchTriangles(patch);
       detail::PatchVertices patchVertices;
-      if (!detail::walkLoop(graph, m, config, patch, table, v, patchVertices) ||
-          std::size_t(patchVertices.count) != triangles.size() + 2)
+      if (!detail::walkLoop(graph, m, config, cubeLoop(graph.pair, config, patch), edge, v, patchVertices))
         detail::walkPatch(graph, m, config, patch, table, v, patchVertices);
 
       for (const auto& tri : triangles) {
@@ -177,8 +178,8 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
         mesh.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
       }
       for (int i = 0; i < patchVertices.count; ++i) {
-        const std::uint32_t w = patchVertices.found[i];
-        flags[w] |= std::uint8_t(1u << detail::locate(surfels[w], m).slot);
+        const int slot = edgeSurfel(config, patchVertices.edgeOfFound[i]).cubeSlot;
+        flags[patchVertices.found[i]] |= std::uint8_t(1u << slot);
       }
     }
   }

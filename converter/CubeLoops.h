@@ -1,0 +1,42 @@
+// The loops of §5.2 read off the configuration tables. In a digital 3-cube, the surfels of one
+// patch form a loop whose consecutive surfels are joined by a beta-arc lying on a cube face;
+// the patch's triangles are oriented, so the triangle edges used once are that loop, in order.
+// Knowing the order, the converter walks a loop by following, from each surfel, the one out-arc
+// that leads to the next cube edge: no search, and no need to look at a surfel to know where it
+// is. Derived once per pair from the tables (themselves computed from Definition 9).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "AdjacencyPair.h"
+#include "ConfigurationTable.h"
+#include "DigitalCube.h"
+
+namespace surftrack {
+
+/// The surfel on a cut edge of a cube, relative to the cube's min corner m.
+struct EdgeSurfel {
+  Voxel inside;      ///< its 1-voxel minus m
+  Direction n = 0;   ///< its normal
+  std::uint8_t cubeSlot = 0;  ///< which of the surfel's 4 cubes this is (cube::cubesOf order)
+  /// Index among the surfel's out-arcs (SurfaceGraph.h order) of the edge neighbour across
+  /// direction e, for each of the 6 directions (only the 4 orthogonal to n are meaningful).
+  std::array<std::uint8_t, 6> arcOf{};
+};
+
+/// The loop of one patch: its cube edges in order (triangle orientation), and for each the
+/// out-arc of its surfel that leads to the next one. length 0: not a loop (the strict-26 tube).
+struct CubeLoop {
+  std::uint8_t length = 0;
+  std::array<std::uint8_t, cube::kEdges> edge{};
+  std::array<std::uint8_t, cube::kEdges> arc{};
+};
+
+/// The surfel on edge k of a cube with configuration `config` (k must be cut).
+const EdgeSurfel& edgeSurfel(std::uint8_t config, int k);
+
+/// The loop of patch p of configuration `config` for `pair`.
+const CubeLoop& cubeLoop(AdjacencyPair pair, std::uint8_t config, int p);
+
+}  // namespace surftrack
