@@ -5,8 +5,6 @@
 namespace surftrack {
 namespace {
 
-using EdgeSurfels = std::array<std::array<EdgeSurfel, cube::kEdges>, 256>;
-
 EdgeSurfels computeEdgeSurfels() {
   EdgeSurfels out{};
   for (int config = 0; config < 256; ++config)
@@ -26,10 +24,6 @@ EdgeSurfels computeEdgeSurfels() {
   return out;
 }
 
-const EdgeSurfels& edgeSurfels() {
-  static const EdgeSurfels table = computeEdgeSurfels();
-  return table;
-}
 
 /// The direction from surfel s's edge to the cube face it shares with surfel t's edge, if the
 /// two surfels' voxels all lie in one face of the cube (a 2-cube {u, u+n, u+e, u+n+e}).
@@ -43,7 +37,7 @@ int faceDirection(const Surfel& s, const Surfel& t) {
   return -1;
 }
 
-using Loops = std::array<std::array<std::array<CubeLoop, CubeTriangulation::kMaxPatches>, 256>, 4>;
+using Loops = std::array<CubeLoops, 4>;
 
 Loops computeLoops() {
   Loops out{};
@@ -85,11 +79,14 @@ Loops computeLoops() {
 
 }  // namespace
 
-const EdgeSurfel& edgeSurfel(std::uint8_t config, int k) { return edgeSurfels()[config][k]; }
+const EdgeSurfels& edgeSurfels() {
+  static const EdgeSurfels table = computeEdgeSurfels();
+  return table;
+}
 
-const CubeLoop& cubeLoop(AdjacencyPair pair, std::uint8_t config, int p) {
+const CubeLoops& cubeLoops(AdjacencyPair pair) {
   static const Loops loops = computeLoops();
-  return loops[int(pair)][config][p];
+  return loops[int(pair)];
 }
 
 }  // namespace surftrack

@@ -33,10 +33,13 @@ struct CubeLoop {
   std::array<std::uint8_t, cube::kEdges> arc{};
 };
 
-/// The surfel on edge k of a cube with configuration `config` (k must be cut).
-const EdgeSurfel& edgeSurfel(std::uint8_t config, int k);
+using EdgeSurfels = std::array<std::array<EdgeSurfel, cube::kEdges>, 256>;
+using CubeLoops = std::array<std::array<CubeLoop, CubeTriangulation::kMaxPatches>, 256>;
 
-/// The loop of patch p of configuration `config` for `pair`.
-const CubeLoop& cubeLoop(AdjacencyPair pair, std::uint8_t config, int p);
+/// edgeSurfels()[config][k]: the surfel on cut edge k of a cube with configuration `config`.
+const EdgeSurfels& edgeSurfels();
+
+/// cubeLoops(pair)[config][p]: the loop of patch p of configuration `config` for `pair`.
+const CubeLoops& cubeLoops(AdjacencyPair pair);
 
 }  // namespace surftrack

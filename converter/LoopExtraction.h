@@ -80,8 +80,8 @@ struct PatchVertices {
 /// taking at each surfel the out-arc that leads to the next edge. False if the patch is no
 /// loop (the strict-26 tube), or if a vertex reached is not the surfel of its cube edge or the
 /// walk does not close: the caller then searches the patch and reports the mismatch.
-inline bool walkLoop(const SurfaceGraph& graph, Voxel m, std::uint8_t config, const CubeLoop& loop,
-                     int startEdge, std::uint32_t v, PatchVertices& out) {
+inline bool walkLoop(const SurfaceGraph& graph, Voxel m, const std::array<EdgeSurfel, cube::kEdges>& onEdges,
+                     const CubeLoop& loop, int startEdge, std::uint32_t v, PatchVertices& out) {
   const int length = loop.length;
   int i = 0;
   while (i < length && loop.edge[i] != startEdge) ++i;
@@ -92,8 +92,10 @@ inline bool walkLoop(const SurfaceGraph& graph, Voxel m, std::uint8_t config, co
   bool matches = true;
   for (int step = 0; step < length; ++step, i = i + 1 == length ? 0 : i + 1) {
     const int k = loop.edge[i];
-    const EdgeSurfel& expected = edgeSurfel(config, k);
-    matches &= graph.surfels[current] == Surfel{m + expected.inside, expected.n};
+    const EdgeSurfel& expected = onEdges[k];
+    const Surfel& s = graph.surfels[current];
+    matches &= (s.c.x == m.x + expected.inside.x) & (s.c.y == m.y + expected.inside.y) &
+               (s.c.z == m.z + expected.inside.z) & (s.n == expected.n);
     out.add(k, current);
     current = column[rowStart[current] + loop.arc[i]];
   }
@@ -143,6 +145,8 @@ template <class BinaryImage>
 TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
   const std::vector<Surfel>& surfels = graph.surfels;
   const auto tables = configurationTables(graph.pair);
+  const CubeLoops& loops = cubeLoops(graph.pair);
+  const EdgeSurfels& onEdges = edgeSurfels();
   TriangleMesh mesh;
   mesh.surfels = surfels;
   mesh.triangles.reserve(2 * surfels.size() + 16);
@@ -168,7 +172,7 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
 
       const auto triangles = table.patchTriangles(patch);
       detail::PatchVertices patchVertices;
-      if (!detail::walkLoop(graph, m, config, cubeLoop(graph.pair, config, patch), edge, v, patchVertices))
+      if (!detail::walkLoop(graph, m, onEdges[config], loops[config][patch], edge, v, patchVertices))
         detail::walkPatch(graph, m, config, patch, table, v, patchVertices);
 
       for (const auto& tri : triangles) {
@@ -178,7 +182,7 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
         mesh.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
       }
       for (int i = 0; i < patchVertices.count; ++i) {
-        const int slot = edgeSurfel(config, patchVertices.edgeOfFound[i]).cubeSlot;
+        const int slot = onEdges[config][patchVertices.edgeOfFound[i]].cubeSlot;
         flags[patchVertices.found[i]] |= std::uint8_t(1u << slot);
       }
     }
