@@ -1,7 +1,9 @@
 // trackComponent on images that cannot be scanned, its errors, and the seed finder.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "FindSeed.h"
 #include "TrackComponent.h"
@@ -32,10 +34,16 @@ TEST(Tracking, ImplicitBallOfRadius900InA4096CubedDomain) {
   const auto seed = seedAlongRay(ball, Voxel{c, c, c}, 0);
   ASSERT_TRUE(seed.has_value());
   EXPECT_EQ(*seed, (Surfel{{c + radius, c, c}, 0}));
-  const SurfaceGraph g = trackComponent(ball, *seed, AdjacencyPair::k26_6);
+  std::vector<std::size_t> reports;
+  const SurfaceGraph g = trackComponent(ball, *seed, AdjacencyPair::k26_6,
+                                        [&](std::size_t found) { reports.push_back(found); });
   // Each line meets the ball in one interval, hence carries exactly 2 surfels along it; by
   // symmetry L_x = L_y = L_z.
   EXPECT_EQ(std::int64_t(g.surfelCount()), 2 * 3 * linesMeetingBall(r2, radius));
+  // Progress: about once per 2^20 surfels found, increasing, never past the total.
+  EXPECT_GE(reports.size(), g.surfelCount() / (std::size_t(1) << 20) - 1);
+  EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
+  EXPECT_LE(reports.back(), g.surfelCount());
 }
 
 TEST(Tracking, BallFromAnySeedInEveryPair) {

@@ -14,12 +14,12 @@
 
 #include "AdjacencyPair.h"
 #include "BetaAdjacency.h"
-#include "AppendBuffer.h"
 #include "BinaryBrickCache.h"
 #include "BrickStepTable.h"
 #include "Image.h"
 #include "SurfaceGraph.h"
 #include "BrickSurfelSet.h"
+#include "FrontQueue.h"
 
 namespace surftrack {
 
@@ -112,32 +112,37 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
   // 1. Breadth-first traversal of beta-arcs from the seed; queue entries are brick << 12 | slot.
   std::size_t arcs = 0;
   {
-    AppendBuffer<std::uint64_t> queue;
+    FrontQueue<std::uint64_t> queue;
+    std::size_t nextReport = std::size_t(1) << 20;
     const Voxel c = seed.inside();
     const std::uint32_t b = cache.brickOf(c);
     const int slot = brickslot::slotOf(brickslot::voxelOf(c.x & 7, c.y & 7, c.z & 7), seed.n);
     visited.resize(cache.brickCount());
     visited.insert(b, slot);
     queue.push(std::uint64_t(b) << 12 | std::uint64_t(slot));
-    for (std::size_t i = 0; i < queue.size(); ++i) {
+    while (!queue.empty()) {
       queue.reserve(kMaxBetaNeighbours);
-      const std::uint32_t brick = std::uint32_t(queue[i] >> 12);
+      const std::uint64_t entry = queue.pop();
+      const std::uint32_t brick = std::uint32_t(entry >> 12);
       std::uint64_t* words = visited.words(brick);
       detail::forEachBetaNeighbour(
-          cache, steps, brick, int(queue[i] & 4095),
+          cache, steps, brick, int(entry & 4095),
           [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE {
             ++arcs;
             std::uint64_t& w = to == brick ? words[toSlot >> 6] : visited.words(to)[toSlot >> 6];
             const std::uint64_t m = std::uint64_t(1) << (toSlot & 63);
-            if (w & m) return;
+            const bool reached = !(w & m);
             w |= m;
-            queue.push(std::uint64_t(to) << 12 | std::uint64_t(toSlot));
+            queue.pushIf(std::uint64_t(to) << 12 | std::uint64_t(toSlot), reached);
           },
           [&] {
             visited.resize(cache.brickCount());
             words = visited.words(brick);
           });
-      if (progress && (i & 0xFFFFF) == 0xFFFFF) progress(queue.size());
+      if (progress && queue.pushed() >= nextReport) {
+        progress(queue.pushed());
+        nextReport += std::size_t(1) << 20;
+      }
     }
   }
 
