@@ -21,6 +21,7 @@
 #include "ConfigurationTable.h"
 #include "CubeLoops.h"
 #include "DigitalCube.h"
+#include "HugePages.h"
 #include "SurfaceGraph.h"
 #include "TriangleMesh.h"
 
@@ -149,7 +150,7 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
   const EdgeSurfels& onEdges = edgeSurfels();
   TriangleMesh mesh;
   mesh.surfels = surfels;
-  mesh.triangles.reserve(2 * surfels.size() + 16);
+  reserveHugePages(mesh.triangles, 2 * surfels.size() + 16);
   // flags[v] bit q: the patch of surfel v in cube cubesOf(surfels[v])[q] has been emitted.
   std::vector<std::uint8_t> flags(surfels.size(), 0);
   // The 4 cubes around a surfel lie in the 3x3x3 neighbourhood of its 1-voxel: read them from

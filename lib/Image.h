@@ -14,13 +14,11 @@
 #include <type_traits>
 #include <vector>
 
+#include "HugePages.h"
 #include "Voxel.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
-#endif
-#if defined(__linux__)
-#include <sys/mman.h>
 #endif
 
 namespace surftrack {
@@ -52,20 +50,6 @@ struct ImageGeometry {
     return p;
   }
 };
-
-/// Asks Linux to back a large buffer, before it is first written, with 2 MiB pages. The tracker
-/// reads a dense volume brick by brick, ten z-slices at a time: with 4 KiB pages nearly every
-/// row of a brick is a TLB miss on volumes of a few hundred MiB. Harmless where unsupported.
-inline void adviseHugePages(void* data, std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t kHuge = std::uintptr_t(1) << 21;
-  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
-  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#else
-  (void)data, (void)bytes;
-#endif
-}
 
 /// A dense volume of scalars (uint8, int16, uint16, int32, float, double, ...), x fastest.
 template <class T>

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "Hash.h"
+#include "HugePages.h"
 #include "Voxel.h"
 
 namespace surftrack {
@@ -105,6 +106,10 @@ class BinaryBrickCache {
       return brickIndex(bx, by, bz);
     }
     slots_[i] = {key, std::uint32_t(bricks_.size())};
+    if (bricks_.size() == bricks_.capacity()) {
+      reserveHugePages(bricks_, 2 * bricks_.size() + 64);
+      reserveHugePages(links_, bricks_.capacity());
+    }
     bricks_.push_back(binarise(key, bx, by, bz));
     links_.emplace_back().fill(kNoLink);
     links_.back()[13] = std::uint32_t(bricks_.size() - 1);

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "HugePages.h"
 #include "Surfel.h"
 
 namespace surftrack {
@@ -26,7 +27,7 @@ class BrickSurfelSet {
 
   /// Makes room for bricks [0, count).
   void resize(std::size_t count) {
-    if (count > words_.size()) words_.resize(std::max(count, 2 * words_.size()), Words{});
+    if (count > words_.size()) resizeHugePages(words_, count);
   }
 
   /// The 48 words of a brick made room for (invalidated by resize).
@@ -43,7 +44,7 @@ class BrickSurfelSet {
 
   /// Freezes the set and numbers its surfels; returns their number.
   std::uint32_t number() {
-    prefix_.resize(words_.size());
+    resizeHugePages(prefix_, words_.size());
     std::uint32_t count = 0;
     for (std::size_t b = 0; b < words_.size(); ++b)
       for (int w = 0; w < kWords; ++w) {

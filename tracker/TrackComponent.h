@@ -16,6 +16,7 @@
 #include "BetaAdjacency.h"
 #include "BinaryBrickCache.h"
 #include "BrickStepTable.h"
+#include "HugePages.h"
 #include "Image.h"
 #include "SurfaceGraph.h"
 #include "BrickSurfelSet.h"
@@ -150,9 +151,10 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
   const std::uint32_t count = visited.number();
   SurfaceGraph result;
   result.pair = pair;
-  result.surfels.resize(count);
-  std::vector<std::uint32_t> rowStart(std::size_t(count) + 1);
-  std::vector<std::uint32_t> targets(arcs);
+  resizeHugePages(result.surfels, count);
+  std::vector<std::uint32_t> rowStart, targets;
+  resizeHugePages(rowStart, std::size_t(count) + 1);
+  resizeHugePages(targets, arcs);
   std::uint32_t v = 0, a = 0;
   visited.forEach([&](std::uint32_t brick, int slot) {
     const int voxel = slot & 511;
