@@ -156,7 +156,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
   resizeHugePages(rowStart, std::size_t(count) + 1);
   resizeHugePages(targets, arcs);
   std::uint32_t v = 0, a = 0;
-  visited.forEach([&](std::uint32_t brick, int slot) {
+  visited.forEach([&](std::uint32_t brick, int slot) SURFTRACK_INLINE {
     const int voxel = slot & 511;
     result.surfels[v] = Surfel{cache.brickOrigin(brick) + Voxel{voxel & 7, (voxel >> 3) & 7, voxel >> 6},
                                Direction(slot >> 9)};
