@@ -149,7 +149,8 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
   const CubeLoops& loops = cubeLoops(graph.pair);
   const EdgeSurfels& onEdges = edgeSurfels();
   TriangleMesh mesh;
-  mesh.surfels = surfels;
+  reserveHugePages(mesh.surfels, surfels.size());
+  mesh.surfels.assign(surfels.begin(), surfels.end());
   reserveHugePages(mesh.triangles, 2 * surfels.size() + 16);
   // flags[v] bit q: the patch of surfel v in cube cubesOf(surfels[v])[q] has been emitted.
   std::vector<std::uint8_t> flags(surfels.size(), 0);
