@@ -7,9 +7,11 @@
 // through are ever created: memory and time stay proportional to the surface, not the volume.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "Hash.h"
@@ -87,6 +89,29 @@ class BinaryBrickCache {
   }
 
   std::size_t brickCount() const { return bricks_.size(); }
+
+  /// All bricks, ordered along a Z-order (Morton) curve of their positions: bricks near each
+  /// other in space come near each other in the list.
+  std::vector<std::uint32_t> bricksInSpaceOrder() const {
+    auto spread = [](std::uint64_t v) {  // 21 bits to every third bit of 63
+      v &= 0x1FFFFF;
+      v = (v | v << 32) & 0x1F00000000FFFFull;
+      v = (v | v << 16) & 0x1F0000FF0000FFull;
+      v = (v | v << 8) & 0x100F00F00F00F00Full;
+      v = (v | v << 4) & 0x10C30C30C30C30C3ull;
+      v = (v | v << 2) & 0x1249249249249249ull;
+      return v;
+    };
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(bricks_.size());
+    for (std::uint32_t b = 0; b < bricks_.size(); ++b) {
+      const std::uint64_t key = bricks_[b].key;  // 21 bits per axis, x lowest
+      keyed[b] = {spread(key) | spread(key >> 21) << 1 | spread(key >> 42) << 2, b};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    std::vector<std::uint32_t> order(bricks_.size());
+    for (std::size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
+    return order;
+  }
 
   /// The index of the brick that contains voxel v.
   std::uint32_t brickOf(Voxel v) { return brickIndex(v.x >> 3, v.y >> 3, v.z >> 3); }

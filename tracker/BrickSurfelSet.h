@@ -42,11 +42,13 @@ class BrickSurfelSet {
     return true;
   }
 
-  /// Freezes the set and numbers its surfels; returns their number.
-  std::uint32_t number() {
+  /// Freezes the set and numbers its surfels, brick by brick in the given order (every brick
+  /// that holds a surfel must appear once); returns their number.
+  std::uint32_t number(std::vector<std::uint32_t> brickOrder) {
     resizeHugePages(prefix_, words_.size());
+    order_ = std::move(brickOrder);
     std::uint32_t count = 0;
-    for (std::size_t b = 0; b < words_.size(); ++b)
+    for (std::uint32_t b : order_)
       for (int w = 0; w < kWords; ++w) {
         prefix_[b][w] = count;
         count += std::uint32_t(std::popcount(words_[b][w]));
@@ -60,20 +62,20 @@ class BrickSurfelSet {
     return prefix_[brick][bit >> 6] + std::uint32_t(std::popcount(words_[brick][bit >> 6] & below));
   }
 
-  /// Calls f(brick, bit) for every marked surfel, in index order.
+  /// Calls f(brick, bit) for every marked surfel, in index order (after number()).
   template <class F>
   void forEach(F&& f) const {
-    for (std::uint32_t b = 0; b < words_.size(); ++b)
+    for (std::uint32_t b : order_)
       for (int w = 0; w < kWords; ++w)
         for (std::uint64_t bits = words_[b][w]; bits; bits &= bits - 1)
           f(b, w * 64 + std::countr_zero(bits));
   }
 
-
  private:
   using Words = std::array<std::uint64_t, kWords>;
   using Prefix = std::array<std::uint32_t, kWords>;
   std::vector<Words> words_;
+  std::vector<std::uint32_t> order_;
   std::vector<Prefix> prefix_;
 };
 

@@ -94,7 +94,8 @@ template <class Cache, class F, class Crossed>
 }  // namespace detail
 
 /// The surface graph G(Sigma, beta) of the kappa-lambda-boundary Sigma containing `seed`.
-/// Vertices are numbered by position (8x8x8 brick by brick); the out-arcs of each vertex are in
+/// Vertices are numbered by position: 8x8x8 brick by brick along a Z-order curve, so that
+/// neighbours in space are mostly neighbours in memory; the out-arcs of each vertex are in
 /// the order of betaNeighbours (see SurfaceGraph.h).
 ///
 /// Two passes over the surface, both local to a brick and its neighbours (BrickStepTable.h):
@@ -148,7 +149,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
   }
 
   // 2. Vertices by rank, arcs by recomputing each vertex's neighbours.
-  const std::uint32_t count = visited.number();
+  const std::uint32_t count = visited.number(cache.bricksInSpaceOrder());
   SurfaceGraph result;
   result.pair = pair;
   resizeHugePages(result.surfels, count);
