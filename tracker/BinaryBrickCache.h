@@ -5,6 +5,8 @@
 // neighbourhood a surfel's beta-neighbours depend on (Definition 38 only looks at voxels within
 // ±1 of c) comes from a single brick in a few bit operations. Only bricks the surface passes
 // through are ever created: memory and time stay proportional to the surface, not the volume.
+// A brick remembers its neighbours once looked up (linkedBrick), so the tracker hashes a brick
+// position about once per brick face the surface crosses, not once per surfel.
 #pragma once
 
 #include <algorithm>
@@ -46,22 +48,13 @@ class BinaryBrickCache {
 
   /// The same, when u's brick index is already known.
   Neighbourhood neighbourhood(std::uint32_t brick, Voxel u) const {
-    return Neighbourhood{u, neighbourhoodBits(brick, u.x & 7, u.y & 7, u.z & 7)};
+    const NeighbourhoodSlices s = neighbourhoodSlices(brick, (u.x & 7) + 8 * (u.y & 7) + 64 * (u.z & 7));
+    return Neighbourhood{u, s.bits[0] | s.bits[1] << 9 | s.bits[2] << 18};
   }
 
-  /// Neighbourhood::bits of the voxel at (lx, ly, lz) in [0, 8)^3 of the brick: three 64-bit
-  /// loads, each bringing the 3 apron rows y .. y+2 of one z-slice.
-  std::uint32_t neighbourhoodBits(std::uint32_t brick, int lx, int ly, int lz) const {
-    return neighbourhoodBits(brick, lx + 8 * ly + 64 * lz);
-  }
-  /// The same for voxel index x + 8y + 64z of the brick.
-  std::uint32_t neighbourhoodBits(std::uint32_t brick, int voxel) const {
-    const NeighbourhoodSlices s = neighbourhoodSlices(brick, voxel);
-    return s.bits[0] | s.bits[1] << 9 | s.bits[2] << 18;
-  }
-
-  /// The neighbourhood as its three z-slices of 9 bits (Neighbourhood::bits = s0 | s1 << 9 |
-  /// s2 << 18): three 64-bit loads, each bringing the apron rows y .. y+2 of one slice.
+  /// The neighbourhood of the voxel with index x + 8y + 64z in the brick, as its three z-slices
+  /// of 9 bits (Neighbourhood::bits = s0 | s1 << 9 | s2 << 18): three 64-bit loads, each
+  /// bringing the apron rows y .. y+2 of one slice.
   NeighbourhoodSlices neighbourhoodSlices(std::uint32_t brick, int voxel) const {
     const Brick& b = bricks_[brick];
     const int lx = voxel & 7, ly = (voxel >> 3) & 7, lz = voxel >> 6;
@@ -154,7 +147,7 @@ class BinaryBrickCache {
   struct Brick {
     std::uint64_t key;
     std::array<std::array<std::uint16_t, 10>, 10> rows;
-    std::uint16_t spare[3];  // read, never used, by neighbourhoodBits' last 64-bit load
+    std::uint16_t spare[3];  // read, never used, by neighbourhoodSlices' last 64-bit load
   };
   struct Slot {
     std::uint64_t key;

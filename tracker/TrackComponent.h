@@ -55,8 +55,9 @@ namespace detail {
 /// order of betaNeighbours. Neighbours in other bricks come through cache.linkedBrick, which
 /// creates (binarises) a brick on first use; `crossed` is called after that may have happened.
 template <class Cache, class F, class Crossed>
-[[gnu::always_inline]] inline void forEachBetaNeighbour(Cache& cache, const BrickStepTable& steps, std::uint32_t b,
-                                 int slot, F&& f, Crossed&& crossed) {
+[[gnu::always_inline]] inline void forEachBetaNeighbour(Cache& cache, const BrickStepTable& steps,
+                                                        std::uint32_t b, int slot, F&& f,
+                                                        Crossed&& crossed) {
   const int voxel = slot & 511;
   const NeighbourhoodSlices slices = cache.neighbourhoodSlices(b, voxel);
   const std::uint8_t border = brickslot::kBorderFlags[voxel];
