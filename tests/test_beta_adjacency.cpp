@@ -7,6 +7,7 @@
 #include <random>
 
 #include "DigitalCube.h"
+#include "PairTestName.h"
 #include "ScanBoundaries.h"
 #include "TrackComponent.h"
 #include "VoxelComponents.h"
@@ -56,8 +57,7 @@ TEST_P(BetaAdjacency, DegreesAndSymmetryOnRandomImages) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPairs, BetaAdjacency, ::testing::ValuesIn(kAllAdjacencyPairs),
-                         [](const auto& info) { return "k" + std::to_string(kappa(info.param)) +
-                                                       "_" + std::to_string(lambda(info.param)); });
+                         surftrack::testing::pairTestName);
 
 std::size_t componentCount(const BinaryVolume& volume, AdjacencyPair pair) {
   return scanBoundaries(binaryView(volume), pair).componentCount;
@@ -153,8 +153,6 @@ TEST(BetaNeighbourTable, AgreesWithDefinition38OnEveryNeighbourhood) {
 }
 
 }  // namespace
-
-#include "TrackComponent.h"
 
 namespace {
 

@@ -7,6 +7,7 @@
 #include <random>
 #include <set>
 
+#include "PairTestName.h"
 #include "ScanBoundaries.h"
 #include "TrackComponent.h"
 #include "VoxelComponents.h"
@@ -79,7 +80,6 @@ TEST_P(JordanTriples, RandomImages) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPairs, JordanTriples, ::testing::ValuesIn(kAllAdjacencyPairs),
-                         [](const auto& info) { return "k" + std::to_string(kappa(info.param)) +
-                                                       "_" + std::to_string(lambda(info.param)); });
+                         surftrack::testing::pairTestName);
 
 }  // namespace

@@ -16,6 +16,7 @@
 
 #include "BoundaryMapping.h"
 #include "LoopExtraction.h"
+#include "PairTestName.h"
 #include "MeshIO.h"
 #include "ScanBoundaries.h"
 #include "SurfaceMesh.h"
@@ -289,10 +290,6 @@ ImageStats checkImage(const BinaryVolume& volume, AdjacencyPair pair, Checks che
   return stats;
 }
 
-std::string pairName(const ::testing::TestParamInfo<AdjacencyPair>& info) {
-  return "k" + std::to_string(kappa(info.param)) + "_" + std::to_string(lambda(info.param));
-}
-
 class LoopExtraction : public ::testing::TestWithParam<AdjacencyPair> {};
 
 // ---------------------------------------------------------------------------------------------
@@ -329,7 +326,8 @@ TEST_P(LoopExtraction, ThousandRandomImages) {
   EXPECT_GT(total.boundaries, 5000u);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllPairs, LoopExtraction, ::testing::ValuesIn(kAllAdjacencyPairs), pairName);
+INSTANTIATE_TEST_SUITE_P(AllPairs, LoopExtraction, ::testing::ValuesIn(kAllAdjacencyPairs),
+                         surftrack::testing::pairTestName);
 
 // ---------------------------------------------------------------------------------------------
 
