@@ -62,6 +62,7 @@ Loops computeLoops() {
         // triangles and stays length 0 (walked by the general search).
         if (boundary != int(triangles.size()) + 2) continue;
         CubeLoop& loop = out[int(pair)][config][p];
+        loop.positionOf.fill(CubeLoop::kNotInLoop);
         int k = table.triangles[table.patchBegin[p]][0];
         for (int i = 0; i < boundary; ++i, k = next[k]) {
           const Surfel s = cube::surfelOnEdge(Voxel{}, k, std::uint8_t(config));
@@ -70,8 +71,15 @@ Loops computeLoops() {
           if (e < 0) throw std::logic_error("configuration table: a loop edge off the cube faces");
           loop.edge[i] = std::uint8_t(k);
           loop.arc[i] = edgeSurfels()[config][k].arcOf[e];
+          loop.cubeSlot[i] = edgeSurfels()[config][k].cubeSlot;
+          loop.positionOf[k] = std::uint8_t(i);
         }
+        if (k != loop.edge[0]) throw std::logic_error("configuration table: a patch boundary is not one loop");
         loop.length = std::uint8_t(boundary);
+        for (const auto& tri : triangles) {
+          auto& out = loop.triangles[loop.triangleCount++];
+          for (int j = 0; j < 3; ++j) out[j] = loop.positionOf[tri[j]];
+        }
       }
     }
   return out;

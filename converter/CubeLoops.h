@@ -27,10 +27,18 @@ struct EdgeSurfel {
 
 /// The loop of one patch: its cube edges in order (triangle orientation), and for each the
 /// out-arc of its surfel that leads to the next one. length 0: not a loop (the strict-26 tube).
+/// The patch's triangles are restated in loop positions, so that a walk that records the vertex
+/// at each position can emit them without looking up cube edges again.
 struct CubeLoop {
+  static constexpr std::uint8_t kNotInLoop = 0xFF;
+
   std::uint8_t length = 0;
   std::array<std::uint8_t, cube::kEdges> edge{};
   std::array<std::uint8_t, cube::kEdges> arc{};
+  std::array<std::uint8_t, cube::kEdges> cubeSlot{};    ///< EdgeSurfel::cubeSlot at each position
+  std::array<std::uint8_t, cube::kEdges> positionOf{};  ///< of each cube edge, or kNotInLoop
+  std::uint8_t triangleCount = 0;
+  std::array<std::array<std::uint8_t, 3>, CubeTriangulation::kMaxTriangles> triangles{};
 };
 
 using EdgeSurfels = std::array<std::array<EdgeSurfel, cube::kEdges>, 256>;

@@ -77,27 +77,25 @@ struct PatchVertices {
   }
 };
 
-/// A loop (§5.2): from vertex v, around the patch's cube edges in the order of its CubeLoop,
-/// taking at each surfel the out-arc that leads to the next edge. False if the patch is no
-/// loop (the strict-26 tube), or if a vertex reached is not the surfel of its cube edge or the
-/// walk does not close: the caller then searches the patch and reports the mismatch.
+/// A loop (§5.2): from vertex v on the loop's cube edge at position `start`, around the patch
+/// in the order of its CubeLoop, taking at each surfel the out-arc that leads to the next edge;
+/// byPosition[i] is the vertex at loop position i. False if a vertex reached is not the surfel
+/// its cube edge must carry or the walk does not close: the caller then searches the patch and
+/// reports the mismatch.
 inline bool walkLoop(const SurfaceGraph& graph, Voxel m, const std::array<EdgeSurfel, cube::kEdges>& onEdges,
-                     const CubeLoop& loop, int startEdge, std::uint32_t v, PatchVertices& out) {
+                     const CubeLoop& loop, int start, std::uint32_t v,
+                     std::array<std::uint32_t, cube::kEdges>& byPosition) {
   const int length = loop.length;
-  int i = 0;
-  while (i < length && loop.edge[i] != startEdge) ++i;
-  if (i == length) return false;
   const auto& rowStart = graph.graph.m_forward.m_rowstart;
   const auto& column = graph.graph.m_forward.m_column;
   std::uint32_t current = v;
   bool matches = true;
-  for (int step = 0; step < length; ++step, i = i + 1 == length ? 0 : i + 1) {
-    const int k = loop.edge[i];
-    const EdgeSurfel& expected = onEdges[k];
+  for (int step = 0, i = start; step < length; ++step, i = i + 1 == length ? 0 : i + 1) {
+    const EdgeSurfel& expected = onEdges[loop.edge[i]];
     const Surfel& s = graph.surfels[current];
     matches &= (s.c.x == m.x + expected.inside.x) & (s.c.y == m.y + expected.inside.y) &
                (s.c.z == m.z + expected.inside.z) & (s.n == expected.n);
-    out.add(k, current);
+    byPosition[i] = current;
     current = column[rowStart[current] + loop.arc[i]];
   }
   return matches && current == v;
@@ -172,12 +170,23 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
       const int patch = table.patchOfEdge[edge];
       if (patch < 0) detail::throwUnreachable(t, m, edge);
 
-      const auto triangles = table.patchTriangles(patch);
-      detail::PatchVertices patchVertices;
-      if (!detail::walkLoop(graph, m, onEdges[config], loops[config][patch], edge, v, patchVertices))
-        detail::walkPatch(graph, m, config, patch, table, v, patchVertices);
+      // A loop (almost always): walk it and emit its triangles by loop position.
+      const CubeLoop& loop = loops[config][patch];
+      std::array<std::uint32_t, cube::kEdges> byPosition;
+      if (loop.length != 0 &&
+          detail::walkLoop(graph, m, onEdges[config], loop, loop.positionOf[edge], v, byPosition)) {
+        for (int i = 0; i < loop.triangleCount; ++i) {
+          const auto& tri = loop.triangles[i];
+          mesh.triangles.push_back({byPosition[tri[0]], byPosition[tri[1]], byPosition[tri[2]]});
+        }
+        for (int i = 0; i < loop.length; ++i) flags[byPosition[i]] |= std::uint8_t(1u << loop.cubeSlot[i]);
+        continue;
+      }
 
-      for (const auto& tri : triangles) {
+      // The strict-26 tube, or a graph that does not match the image (which this reports).
+      detail::PatchVertices patchVertices;
+      detail::walkPatch(graph, m, config, patch, table, v, patchVertices);
+      for (const auto& tri : table.patchTriangles(patch)) {
         const std::int32_t a = patchVertices.onEdge[tri[0]], b = patchVertices.onEdge[tri[1]],
                            c = patchVertices.onEdge[tri[2]];
         if ((a | b | c) < 0) detail::throwUnreachable(t, m, a < 0 ? tri[0] : b < 0 ? tri[1] : tri[2]);
