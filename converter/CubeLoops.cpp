@@ -24,7 +24,6 @@ EdgeSurfels computeEdgeSurfels() {
   return out;
 }
 
-
 /// The direction from surfel s's edge to the cube face it shares with surfel t's edge, if the
 /// two surfels' voxels all lie in one face of the cube (a 2-cube {u, u+n, u+e, u+n+e}).
 int faceDirection(const Surfel& s, const Surfel& t) {

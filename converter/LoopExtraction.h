@@ -29,25 +29,6 @@ namespace surftrack {
 
 namespace detail {
 
-/// Where surfel s sits in the digital 3-cube with min corner m: its cube edge, its 1-voxel's
-/// corner, and which of s's 4 cubes m is (cube::cubesOf order). edge < 0: s is not in the cube.
-struct SurfelInCube {
-  int edge = -1;
-  int corner = 0;
-  int slot = 0;
-};
-
-inline SurfelInCube locate(const Surfel& s, Voxel m) {
-  const int d[3] = {s.c.x - m.x, s.c.y - m.y, s.c.z - m.z};
-  if (unsigned(d[0]) > 1u || unsigned(d[1]) > 1u || unsigned(d[2]) > 1u) return {};
-  const int a = axisOf(s.n);
-  // The 0-voxel c + n must be in the cube too: c is on the low face along a iff n points up.
-  if (d[a] != (signOf(s.n) > 0 ? 0 : 1)) return {};
-  const int corner = d[0] | d[1] << 1 | d[2] << 2;
-  const int b = a == 0 ? 1 : 0, c = a == 2 ? 1 : 2;  // the two other axes, b < c
-  return {cube::edgeBetween(corner, corner ^ (1 << a)), corner, d[b] | d[c] << 1};
-}
-
 /// The configuration of the cube with min corner c + offset, offset in {-1, 0}^3, from the
 /// 3x3x3 neighbourhood bits of voxel c (Neighbourhood::bitOf): its corners are the bits at
 /// bitOf(offset) + {0, 1, 3, 4, 9, 10, 12, 13}.
@@ -117,22 +98,6 @@ inline void walkPatch(const SurfaceGraph& graph, Voxel m, std::uint8_t config, i
     }
 }
 
-/// For a surfel with normal n, the min corner of each of its 4 cubes (cube::cubesOf order)
-/// minus its 1-voxel.
-inline constexpr std::array<std::array<Voxel, 4>, 6> kCubeOffsets = [] {
-  std::array<std::array<Voxel, 4>, 6> out{};
-  for (Direction n = 0; n < 6; ++n) {
-    const int a = axisOf(n), b = a == 0 ? 1 : 0, c = a == 2 ? 1 : 2;
-    for (int q = 0; q < 4; ++q) {
-      Voxel m = signOf(n) > 0 ? Voxel{} : unitVector(n);
-      m[b] -= q & 1;
-      m[c] -= (q >> 1) & 1;
-      out[n][q] = m;
-    }
-  }
-  return out;
-}();
-
 }  // namespace detail
 
 /// The kappa-lambda-continuous analog of the boundary whose surface graph is `graph`, tracked in
@@ -162,11 +127,10 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
     const std::uint32_t around = cache.neighbourhood(t.inside()).bits;
     for (int q = 0; q < 4; ++q) {
       if (flags[v] & (1u << q)) continue;
-      const Voxel offset = detail::kCubeOffsets[t.n][q];
+      const auto [offset, edge] = cube::kCubesAroundSurfel[t.n][q];
       const Voxel m = t.c + offset;
       const std::uint8_t config = detail::configurationFrom(around, offset);
       const CubeTriangulation& table = tables[config];
-      const int edge = detail::locate(t, m).edge;  // >= 0: m is one of t's cubes
       const int patch = table.patchOfEdge[edge];
       if (patch < 0) detail::throwUnreachable(t, m, edge);
 

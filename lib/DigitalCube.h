@@ -74,18 +74,33 @@ constexpr bool edgeIsCut(int k, std::uint8_t config) {
   return ((config >> edgeLowCorner(k)) & 1) != ((config >> edgeHighCorner(k)) & 1);
 }
 
+/// The 4 digital 3-cubes around the grid edge of a surfel with normal n, q = 0..3: bit 0 of q
+/// set when the cube extends towards -b from the edge, bit 1 towards -c (b < c the two axes
+/// orthogonal to n). `offset` is the cube's min corner minus the surfel's 1-voxel, `edge` the
+/// cube edge the surfel lies on.
+struct CubeAroundSurfel {
+  Voxel offset;
+  int edge = 0;
+};
+inline constexpr std::array<std::array<CubeAroundSurfel, 4>, 6> kCubesAroundSurfel = [] {
+  std::array<std::array<CubeAroundSurfel, 4>, 6> out{};
+  for (Direction n = 0; n < 6; ++n) {
+    const int a = axisOf(n);
+    const auto [b, c] = otherAxes(a);
+    for (int q = 0; q < 4; ++q) {
+      Voxel m = signOf(n) > 0 ? Voxel{} : unitVector(n);  // low end of the edge along a
+      m[b] -= q & 1;
+      m[c] -= (q >> 1) & 1;
+      out[n][q] = {m, edgeOf(m, Surfel{Voxel{}, n})};
+    }
+  }
+  return out;
+}();
+
 /// Min corners of the 4 digital 3-cubes that contain the grid edge of surfel s.
 inline std::array<Voxel, 4> cubesOf(const Surfel& s) {
-  int a = axisOf(s.n);
-  Voxel lo = signOf(s.n) > 0 ? s.inside() : s.outside();  // low end of the edge along a
-  auto [b, c] = otherAxes(a);
   std::array<Voxel, 4> out{};
-  for (int q = 0; q < 4; ++q) {
-    Voxel m = lo;
-    m[b] -= (q & 1);
-    m[c] -= (q >> 1) & 1;
-    out[q] = m;
-  }
+  for (int q = 0; q < 4; ++q) out[q] = s.inside() + kCubesAroundSurfel[s.n][q].offset;
   return out;
 }
 

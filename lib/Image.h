@@ -61,8 +61,7 @@ class DenseImage {
   explicit DenseImage(Dims dims, T fill = T{}, ImageGeometry geometry = {})
       : dims_(dims), geometry_(geometry) {
     if (dims.empty()) throw std::invalid_argument("image dimensions must be positive");
-    data_.reserve(dims.count());
-    adviseHugePages(data_.data(), dims.count() * sizeof(T));
+    reserveHugePages(data_, dims.count());
     data_.assign(dims.count(), fill);
   }
 
@@ -123,17 +122,12 @@ class ThresholdImage {
       if (mode_ == Mode::Compare && x0 >= 0 && y0 >= 0 && z0 >= 0 && x0 + width <= d.nx &&
           y0 + ny <= d.ny && z0 + nz <= d.nz &&
           image_->index(x0, y0 + ny - 1, z0 + nz - 1) + 16 <= image_->data().size()) {
-        const __m128i flip = _mm_set1_epi8(char(0x80));
-        const __m128i t = _mm_set1_epi8(char(threshold_ ^ 0x80));
-        const int keep = (1 << width) - 1;
+        const unsigned keep = (1u << width) - 1;
         const std::size_t sliceStep = std::size_t(d.nx) * std::size_t(d.ny);
         const T* slice = &image_->at(x0, y0, z0);
         for (int k = 0; k < nz; ++k, slice += sliceStep) {
           const T* row = slice;
-          for (int j = 0; j < ny; ++j, row += d.nx) {
-            const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
-            *out++ = std::uint16_t(_mm_movemask_epi8(_mm_cmpgt_epi8(_mm_xor_si128(v, flip), t)) & keep);
-          }
+          for (int j = 0; j < ny; ++j, row += d.nx) *out++ = std::uint16_t(compare16(row) & keep);
         }
         return;
       }
@@ -152,8 +146,7 @@ class ThresholdImage {
       return outside_ ? all : 0;
     const int lo = x0 < 0 ? -x0 : 0, hi = x0 + count > d.nx ? d.nx - x0 : count;
     const std::uint64_t bits = outside_ ? all & ~(lowBits(hi - lo) << lo) : 0;
-    const std::size_t first = image_->index(x0 + lo, y, z);
-    return bits | (compare(&image_->data()[first], hi - lo, image_->data().size() - first) << lo);
+    return bits | (compare(&image_->at(x0 + lo, y, z), hi - lo) << lo);
   }
 
  private:
@@ -161,27 +154,26 @@ class ThresholdImage {
 
   static std::uint64_t lowBits(int n) { return n >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1; }
 
-  /// Bit i is values[i] > s, for i < n <= 64 — exactly operator()'s test. `readable` values
-  /// from `values` on belong to the image: vector loads may go past n, never past those.
-  std::uint64_t compare(const T* values, int n, std::size_t readable) const {
-    (void)readable;
+#if defined(__SSE2__)
+  /// Bit i is values[i] > s for the 16 uint8 values from `values` (mode Compare): unsigned
+  /// bytes compared as signed after flipping their top bit.
+  unsigned compare16(const std::uint8_t* values) const {
+    const __m128i flip = _mm_set1_epi8(char(0x80));
+    const __m128i t = _mm_set1_epi8(char(threshold_ ^ 0x80));
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(values));
+    return unsigned(_mm_movemask_epi8(_mm_cmpgt_epi8(_mm_xor_si128(v, flip), t)));
+  }
+#endif
+
+  /// Bit i is values[i] > s, for i < n <= 64 — exactly operator()'s test.
+  std::uint64_t compare(const T* values, int n) const {
     if (mode_ == Mode::AllOnes) return lowBits(n);
     if (mode_ == Mode::AllZeros) return 0;
     std::uint64_t bits = 0;
     int i = 0;
     if constexpr (std::is_same_v<T, std::uint8_t>) {
 #if defined(__SSE2__)
-      // Unsigned bytes compared as signed after flipping their top bit, 16 at a time.
-      const __m128i flip = _mm_set1_epi8(char(0x80));
-      const __m128i t = _mm_set1_epi8(char(threshold_ ^ 0x80));
-      // A row shorter than 16 (the tracker's bricks read 10) still takes one load when the
-      // image has 16 bytes there; the bits past n are cleared below.
-      for (; i < n && std::size_t(i) + 16 <= readable; i += 16) {
-        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(values + i));
-        const int mask = _mm_movemask_epi8(_mm_cmpgt_epi8(_mm_xor_si128(v, flip), t));
-        bits |= std::uint64_t(std::uint16_t(mask)) << i;
-      }
-      if (i >= n) return bits & lowBits(n);
+      for (; i + 16 <= n; i += 16) bits |= std::uint64_t(compare16(values + i)) << i;
 #endif
     }
     if constexpr (std::is_integral_v<T> && sizeof(T) <= 4)

@@ -121,31 +121,39 @@ TEST(EdgeRule, Kappa6TurnsInwardWhereKappa18TurnsOutward) {
 
 namespace {
 
+/// Every neighbourhood (Neighbourhood::bits around u = (0,0,0)) of a surfel with normal n that
+/// Definition 38 can tell apart: u = 1, u + n = 0, and all 2^16 patterns of the other voxels of
+/// the 3x3x2 slab spanned by u and u + n.
+std::vector<std::uint32_t> neighbourhoodsOfASurfel(Direction n) {
+  const Voxel u{0, 0, 0}, un = unitVector(n);
+  std::vector<int> relevant;
+  for (int b = 0; b < 27; ++b) {
+    const Voxel d{b % 3 - 1, (b / 3) % 3 - 1, b / 9 - 1};
+    const bool inSlab = d[axisOf(n)] == 0 || d[axisOf(n)] == signOf(n);
+    if (inSlab && d != u && d != un) relevant.push_back(Neighbourhood::bitOf(d));
+  }
+  EXPECT_EQ(relevant.size(), 16u);
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t pattern = 0; pattern < (1u << relevant.size()); ++pattern) {
+    std::uint32_t bits = 1u << Neighbourhood::bitOf(u);
+    for (std::size_t i = 0; i < relevant.size(); ++i)
+      if ((pattern >> i) & 1) bits |= 1u << relevant[i];
+    out.push_back(bits);
+  }
+  return out;
+}
+
 TEST(BetaNeighbourTable, AgreesWithDefinition38OnEveryNeighbourhood) {
   // The tracker's table must give the reference neighbours, in the same order, for every
   // pattern of the 16 voxels Definition 38 looks at around a surfel (u = 1, u + n = 0).
   for (AdjacencyPair pair : kAllAdjacencyPairs) {
     const BetaNeighbourTable table(pair);
     for (Direction n = 0; n < 6; ++n) {
-      const Voxel u{0, 0, 0}, un = unitVector(n);
-      std::vector<int> relevant;
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const Voxel d{dx, dy, dz};
-            // The 3x3x2 slab spanned by u and u + n, less those two.
-            const bool inSlab = d[axisOf(n)] == 0 || d[axisOf(n)] == signOf(n);
-            if (inSlab && d != u && d != un) relevant.push_back(Neighbourhood::bitOf(d));
-          }
-      ASSERT_EQ(relevant.size(), 16u);
       const Surfel t{Voxel{5, -3, 7}, n};
-      for (std::uint32_t pattern = 0; pattern < (1u << 16); ++pattern) {
-        std::uint32_t bits = 1u << Neighbourhood::bitOf(u);
-        for (int i = 0; i < 16; ++i)
-          if ((pattern >> i) & 1) bits |= 1u << relevant[i];
+      for (const std::uint32_t bits : neighbourhoodsOfASurfel(n)) {
         Surfel expected[kMaxBetaNeighbours], found[kMaxBetaNeighbours];
         const int k = betaNeighbours(Neighbourhood{t.c, bits}, t, pair, expected);
-        ASSERT_EQ(table.neighbours(bits, t, found), k) << toString(pair) << " pattern " << pattern;
+        ASSERT_EQ(table.neighbours(bits, t, found), k) << toString(pair) << " neighbourhood " << bits;
         for (int j = 0; j < k; ++j) ASSERT_EQ(found[j], expected[j]) << toString(pair);
       }
     }
@@ -171,21 +179,11 @@ TEST(BrickStepTable, TrackerStepsAgreeWithDefinition38AtEveryPlaceOfABrick) {
   for (AdjacencyPair pair : kAllAdjacencyPairs) {
     const BrickStepTable steps(pair);
     for (Direction n = 0; n < 6; ++n) {
-      const Voxel u{0, 0, 0}, un = unitVector(n);
-      std::vector<int> relevant;
-      for (int b = 0; b < 27; ++b) {
-        const Voxel d{b % 3 - 1, (b / 3) % 3 - 1, b / 9 - 1};
-        const bool inSlab = d[axisOf(n)] == 0 || d[axisOf(n)] == signOf(n);
-        if (inSlab && d != u && d != un) relevant.push_back(b);
-      }
-      ASSERT_EQ(relevant.size(), 16u);
+      const std::vector<std::uint32_t> neighbourhoods = neighbourhoodsOfASurfel(n);
       for (const Voxel& place : places) {
         const Surfel t{Voxel{40, -9, 13} + place, n};
         const int slot = brickslot::slotOf(brickslot::voxelOf(place.x, place.y, place.z), n);
-        for (std::uint32_t pattern = 0; pattern < (1u << 16); ++pattern) {
-          std::uint32_t bits = 1u << Neighbourhood::bitOf(u);
-          for (int i = 0; i < 16; ++i)
-            if ((pattern >> i) & 1) bits |= 1u << relevant[i];
+        for (const std::uint32_t bits : neighbourhoods) {
           Surfel expected[kMaxBetaNeighbours];
           const int k = betaNeighbours(Neighbourhood{t.c, bits}, t, pair, expected);
           FixedNeighbourhood cache{{{bits & 511u, (bits >> 9) & 511u, bits >> 18}}};
@@ -199,9 +197,9 @@ TEST(BrickStepTable, TrackerStepsAgreeWithDefinition38AtEveryPlaceOfABrick) {
                 found.push_back(Surfel{t.c + offset + local - place, Direction(to >> 9)});
               },
               [] {});
-          ASSERT_EQ(int(found.size()), k) << toString(pair) << " pattern " << pattern;
+          ASSERT_EQ(int(found.size()), k) << toString(pair) << " neighbourhood " << bits;
           for (int j = 0; j < k; ++j)
-            ASSERT_EQ(found[j], expected[j]) << toString(pair) << " pattern " << pattern << " place " << place;
+            ASSERT_EQ(found[j], expected[j]) << toString(pair) << " neighbourhood " << bits << " place " << place;
         }
       }
     }

@@ -96,8 +96,6 @@ class BetaNeighbourTable {
     std::array<std::array<Surfel, 2>, 2> links{};  // [0]: of 1-voxels, [1]: of 0-voxels
   };
 
-  bool kappa26() const { return kappa26_; }
-  bool lambda26() const { return lambda26_; }
   /// Edge rule k (by increasing Direction code of e) of a surfel with normal n.
   const EdgeRule& edgeRule(Direction n, int k) const { return edges_[n][k]; }
   /// Cube rule q (the order of betaNeighbours) of a surfel with normal n.

@@ -141,7 +141,6 @@ class BinaryBrickCache {
     return Voxel{g(key), g(key >> 21), g(key >> 42)};
   }
 
-
  private:
   // Voxels 8b-1 .. 8b+8 on each axis: rows[z][y] bit x is voxel (8bx-1+x, 8by-1+y, 8bz-1+z).
   struct Brick {

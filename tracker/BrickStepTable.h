@@ -1,6 +1,5 @@
-// Definition 38 recast as moves between the tracker's surfel slots. The tracker keeps the
-// surfels of each 8x8x8 brick of the image in 6 x 512 slots, slot = n * 512 + x + 8y + 64z for
-// the surfel (c, n) whose 1-voxel c sits at (x, y, z) in the brick. A beta-neighbour of a surfel
+// Definition 38 recast as moves between the tracker's surfel slots (BrickSlot.h). A
+// beta-neighbour of a surfel
 // is then, most of the time, a fixed slot offset inside the same brick; it lies in another
 // brick only when the surfel's voxel is on the brick's border on the side the neighbour moves
 // to. Both facts are tabulated here from BetaNeighbourTable (itself filled by the reference
@@ -12,30 +11,11 @@
 
 #include "AdjacencyPair.h"
 #include "BetaNeighbourTable.h"
+#include "BrickSlot.h"
 #include "Voxel.h"
 
 namespace surftrack {
 
-namespace brickslot {
-constexpr int kVoxels = 512;         // voxels of a brick
-constexpr int kSlots = 6 * kVoxels;  // surfel slots of a brick
-
-constexpr int voxelOf(int x, int y, int z) { return x + 8 * y + 64 * z; }
-constexpr int slotOf(int voxel, Direction n) { return n * kVoxels + voxel; }
-
-/// Bit 2a (2a+1) is set when the voxel is on the low (high) face of the brick along axis a.
-constexpr std::uint8_t borderFlags(int voxel) {
-  const int c[3] = {voxel & 7, (voxel >> 3) & 7, voxel >> 6};
-  std::uint8_t f = 0;
-  for (int a = 0; a < 3; ++a) f |= std::uint8_t((c[a] == 0) << (2 * a) | (c[a] == 7) << (2 * a + 1));
-  return f;
-}
-inline constexpr std::array<std::uint8_t, kVoxels> kBorderFlags = [] {
-  std::array<std::uint8_t, kVoxels> flags{};
-  for (int v = 0; v < kVoxels; ++v) flags[v] = borderFlags(v);
-  return flags;
-}();
-}  // namespace brickslot
 
 /// One beta-neighbour as a move from the surfel's slot.
 struct BrickStep {
@@ -70,8 +50,6 @@ class BrickStepTable {
 
   explicit BrickStepTable(AdjacencyPair pair) {
     const BetaNeighbourTable beta(pair);
-    kappa26_ = beta.kappa26();
-    lambda26_ = beta.lambda26();
     for (Direction n = 0; n < 6; ++n) {
       for (int k = 0; k < 4; ++k) {
         const auto& rule = beta.edgeRule(n, k);
@@ -82,16 +60,13 @@ class BrickStepTable {
       for (int q = 0; q < 4; ++q) {
         const auto& rule = beta.cubeRule(n, q);
         CubeSteps& c = cubes_[n][q];
-        // A pattern no neighbourhood has (bit 27 is outside it) when the pair lacks the link;
-        // computeCandidates uses the same value.
-        constexpr std::uint32_t kNever = 1u << 27;
         c.mask = rule.mask;
-        c.strictOnes = kappa26_ ? rule.strictOnes : kNever;
-        c.strictZeros = lambda26_ ? rule.strictZeros : kNever;
+        c.strictOnes = kappa(pair) == 26 ? rule.strictOnes : kNever;
+        c.strictZeros = lambda(pair) == 26 ? rule.strictZeros : kNever;
         for (int w = 0; w < 2; ++w)
           for (int j = 0; j < 2; ++j) c.links[w][j] = BrickStep::of(rule.links[w][j], n);
       }
-      computeCandidates(n, 1u << 27);
+      computeCandidates(n);
       computeSlicePatterns(n);
     }
   }
@@ -109,12 +84,14 @@ class BrickStepTable {
     return t[0][slices[0]] | t[1][slices[1]] | t[2][slices[2]];
   }
 
-  bool kappa26() const { return kappa26_; }
-  bool lambda26() const { return lambda26_; }
   const std::array<EdgeSteps, 4>& edges(Direction n) const { return edges_[n]; }
   const std::array<CubeSteps, 4>& cubes(Direction n) const { return cubes_[n]; }
 
  private:
+  // The strict pattern of a cube when the pair has no such link: no neighbourhood has it (bit
+  // 27 lies outside the 27 bits), so the tracker's test never matches.
+  static constexpr std::uint32_t kNever = 1u << 27;
+
   void computeSlicePatterns(Direction n) {
     for (int k = 0; k < 3; ++k)
       for (std::uint32_t v = 0; v < 512; ++v) {
@@ -127,7 +104,7 @@ class BrickStepTable {
       }
   }
 
-  void computeCandidates(Direction n, std::uint32_t never) {
+  void computeCandidates(Direction n) {
     std::uint32_t edgeBits = 0;
     for (const EdgeSteps& e : edges_[n]) edgeBits |= 1u << e.aBit | 1u << e.bBit;
     for (int pattern = 0; pattern < 256; ++pattern) {
@@ -140,13 +117,12 @@ class BrickStepTable {
         const CubeSteps& c = cubes_[n][q];
         const std::uint32_t known = c.mask & edgeBits;
         for (std::uint32_t strict : {c.strictOnes, c.strictZeros})
-          if (strict != never && (bits & known) == (strict & known))
+          if (strict != kNever && (bits & known) == (strict & known))
             candidates_[n][pattern] |= std::uint8_t(1u << q);
       }
     }
   }
 
-  bool kappa26_ = false, lambda26_ = false;
   std::array<std::array<std::uint8_t, 256>, 6> candidates_{};
   std::array<std::array<std::array<std::uint8_t, 512>, 3>, 6> slicePatterns_{};
   std::array<std::array<EdgeSteps, 4>, 6> edges_{};

@@ -1,29 +1,23 @@
 // The tracker's visited structure: for each brick of the image cache (8x8x8 voxels), one bit
-// per (voxel, normal) — 6 x 512 bits, 384 bytes — so marking a surfel touches the same few
+// per surfel slot (BrickSlot.h) — 6 x 512 bits, 384 bytes — so marking a surfel touches the same few
 // cache lines as reading its neighbourhood. Once the traversal is over, a prefix count per
 // 64-bit word turns every bit into a dense vertex index (brick order, then bit order) in O(1),
 // with no hashing of surfels at all.
 #pragma once
 
-#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
 #include <vector>
 
+#include "BrickSlot.h"
 #include "HugePages.h"
-#include "Surfel.h"
 
 namespace surftrack {
 
 class BrickSurfelSet {
  public:
-  static constexpr int kWords = 6 * 512 / 64;
-
-  /// The bit of surfel (c, n) whose 1-voxel c has coordinates `local` in [0, 8)^3 in its brick.
-  static int bitOf(Voxel local, Direction n) {
-    return n * 512 + local.z * 64 + local.y * 8 + local.x;
-  }
+  static constexpr int kWords = brickslot::kSlots / 64;
 
   /// Makes room for bricks [0, count).
   void resize(std::size_t count) {

@@ -15,12 +15,13 @@
 #include "AdjacencyPair.h"
 #include "BetaAdjacency.h"
 #include "BinaryBrickCache.h"
+#include "BrickSlot.h"
 #include "BrickStepTable.h"
+#include "BrickSurfelSet.h"
+#include "FrontQueue.h"
 #include "HugePages.h"
 #include "Image.h"
 #include "SurfaceGraph.h"
-#include "BrickSurfelSet.h"
-#include "FrontQueue.h"
 
 namespace surftrack {
 
@@ -53,7 +54,8 @@ namespace detail {
 
 /// Calls f(brick, slot) for each beta-neighbour of the surfel in `slot` of brick b, in the
 /// order of betaNeighbours. Neighbours in other bricks come through cache.linkedBrick, which
-/// creates (binarises) a brick on first use; `crossed` is called after that may have happened.
+/// creates (binarises) a brick on first use; `crossed` is called after that may have happened,
+/// before f, so that per-brick state can grow with the cache.
 template <class Cache, class F, class Crossed>
 [[gnu::always_inline]] inline void forEachBetaNeighbour(Cache& cache, const BrickStepTable& steps,
                                                         std::uint32_t b, int slot, F&& f,
@@ -126,22 +128,17 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
     while (!queue.empty()) {
       queue.reserve(kMaxBetaNeighbours);
       const std::uint64_t entry = queue.pop();
-      const std::uint32_t brick = std::uint32_t(entry >> 12);
-      std::uint64_t* words = visited.words(brick);
       detail::forEachBetaNeighbour(
-          cache, steps, brick, int(entry & 4095),
+          cache, steps, std::uint32_t(entry >> 12), int(entry & 4095),
           [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE {
             ++arcs;
-            std::uint64_t& w = to == brick ? words[toSlot >> 6] : visited.words(to)[toSlot >> 6];
+            std::uint64_t& w = visited.words(to)[toSlot >> 6];
             const std::uint64_t m = std::uint64_t(1) << (toSlot & 63);
             const bool reached = !(w & m);
             w |= m;
             queue.pushIf(std::uint64_t(to) << 12 | std::uint64_t(toSlot), reached);
           },
-          [&] {
-            visited.resize(cache.brickCount());
-            words = visited.words(brick);
-          });
+          [&] { visited.resize(cache.brickCount()); });
       if (progress && queue.pushed() >= nextReport) {
         progress(queue.pushed());
         nextReport += std::size_t(1) << 20;
