@@ -2,9 +2,11 @@
 // noisy spheres of the Figure 9 protocol (spec.md §7), and on an implicit ball of radius 900 in
 // a 4096^3 domain that can be neither stored nor scanned. Memory is the tracker's own peak:
 // each case runs in a child process that reports its peak resident size minus its size just
-// before tracking (so the stored image does not count).
+// before tracking (so the stored image does not count). Each case also times, in the same run,
+// the baseline issue 2 names, a hash-set depth-first traversal (HashSetTraversal.h), and
+// prints the speed ratio: absolute speeds drift between runs on a VM, the ratio much less.
 //
-//   bench_tracking [--sizes 64,128,...] [--quick] [--reps N] [--pair 26-6]
+//   bench_tracking [--sizes 64,128,...] [--quick] [--reps N] [--pair 26-6] [--no-baseline]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -22,6 +24,7 @@
 
 #include "BenchSupport.h"
 #include "FindSeed.h"
+#include "HashSetTraversal.h"
 #include "SphereImage.h"
 #include "TrackComponent.h"
 
@@ -77,11 +80,17 @@ Measurement measure(int reps, const Track& track) {
   return m;
 }
 
-void printRow(const std::string& name, const Measurement& m) {
-  std::printf("%-28s %12zu %10.1f %10.1f %9.2f %9.2f %10.1f %8.0f\n", name.c_str(), m.surfels,
+// One table row; `baseline` (a measurement of hashSetTraversal) is left out when it has no time.
+void printRow(const std::string& name, const Measurement& m, const Measurement& baseline) {
+  std::printf("%-28s %12zu %10.1f %10.1f %9.2f %9.2f %10.1f %8.0f", name.c_str(), m.surfels,
               1e3 * m.wallSeconds, 1e3 * m.cpuSeconds, m.surfels / m.wallSeconds / 1e6,
               m.surfels / m.cpuSeconds / 1e6, m.peakKiB / 1024.0,
               m.surfels ? 1024.0 * m.peakKiB / double(m.surfels) : 0.0);
+  if (baseline.cpuSeconds > 0) {
+    if (baseline.surfels != m.surfels) throw std::runtime_error(name + ": the baseline found another surface");
+    std::printf(" %9.2f %6.1fx", baseline.surfels / baseline.cpuSeconds / 1e6, baseline.cpuSeconds / m.cpuSeconds);
+  }
+  std::printf("\n");
   std::fflush(stdout);
 }
 
@@ -92,7 +101,7 @@ int main(int argc, char** argv) {
     std::vector<int> sizes{64, 128, 256, 512, 1024};
     int reps = 5;
     AdjacencyPair pair = AdjacencyPair::k26_6;
-    bool implicitBall = true;
+    bool implicitBall = true, baseline = true;
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
       auto value = [&]() -> std::string {
@@ -103,21 +112,24 @@ int main(int argc, char** argv) {
       else if (a == "--quick") sizes = {64, 128, 256}, reps = 3, implicitBall = false;
       else if (a == "--reps") reps = std::stoi(value());
       else if (a == "--pair") pair = parseAdjacencyPair(value());
+      else if (a == "--no-baseline") baseline = false;
       else throw std::invalid_argument("unknown option " + a);
     }
     std::printf("trackComponent throughput, pair %s, median of %d runs, one thread\n",
                 toString(pair).c_str(), reps);
-    std::printf("%-28s %12s %10s %10s %9s %9s %10s %8s\n", "case", "surfels", "wall ms",
-                "cpu ms", "M/s wall", "M/s cpu", "peak MiB", "B/surfel");
+    std::printf("%-28s %12s %10s %10s %9s %9s %10s %8s%s\n", "case", "surfels", "wall ms",
+                "cpu ms", "M/s wall", "M/s cpu", "peak MiB", "B/surfel",
+                baseline ? "  hash-set M/s cpu  ratio" : "");
     for (int q : sizes)
       for (double noise : {0.0, 0.01, 0.05}) {
         const bench::NoisySphere sphere = bench::makeNoisySphere(q, noise);
         const auto image = sphere.binary();
         const Surfel seed = bench::protocolSeed(sphere);
-        const Measurement m = measure(q >= 512 ? std::min(reps, 3) : reps, [&] {
-          return trackComponent(image, seed, pair).surfelCount();
-        });
-        printRow("sphere q=" + std::to_string(q) + " p=" + std::to_string(int(noise * 100)) + "%", m);
+        const int runs = q >= 512 ? std::min(reps, 3) : reps;
+        const Measurement m = measure(runs, [&] { return trackComponent(image, seed, pair).surfelCount(); });
+        const Measurement b = baseline ? measure(runs, [&] { return bench::hashSetTraversal(image, seed, pair); })
+                                       : Measurement{};
+        printRow("sphere q=" + std::to_string(q) + " p=" + std::to_string(int(noise * 100)) + "%", m, b);
       }
     if (implicitBall) {
       const int c = 2048, radius = 900;
@@ -127,9 +139,11 @@ int main(int argc, char** argv) {
         return dx * dx + dy * dy + dz * dz <= r2;
       });
       const Surfel seed = *seedAlongRay(ball, Voxel{c, c, c}, 0);
-      printRow("implicit ball R=900 in 4096^3", measure(std::min(reps, 3), [&] {
-                 return trackComponent(ball, seed, pair).surfelCount();
-               }));
+      const int runs = std::min(reps, 3);
+      const Measurement m = measure(runs, [&] { return trackComponent(ball, seed, pair).surfelCount(); });
+      const Measurement b = baseline ? measure(runs, [&] { return bench::hashSetTraversal(ball, seed, pair); })
+                                     : Measurement{};
+      printRow("implicit ball R=900 in 4096^3", m, b);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -119,12 +119,21 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
   std::vector<std::uint8_t> flags(surfels.size(), 0);
   // The 4 cubes around a surfel lie in the 3x3x3 neighbourhood of its 1-voxel: read them from
   // a brick cache rather than voxel by voxel from the image.
+  // Tracked graphs number their vertices brick by brick, so the brick of the last surfel is
+  // almost always the brick of the next one: remember it rather than look it up.
   BinaryBrickCache<BinaryImage> cache(image);
+  Voxel lastBrick{1 << 30, 0, 0};
+  std::uint32_t brick = 0;
 
   for (std::uint32_t v = 0; v < surfels.size(); ++v) {
     if (flags[v] == 0xF) continue;
     const Surfel& t = surfels[v];
-    const std::uint32_t around = cache.neighbourhood(t.inside()).bits;
+    const Voxel brickOfT{t.c.x >> 3, t.c.y >> 3, t.c.z >> 3};
+    if (brickOfT != lastBrick) [[unlikely]] {
+      brick = cache.brickIndex(brickOfT.x, brickOfT.y, brickOfT.z);
+      lastBrick = brickOfT;
+    }
+    const std::uint32_t around = cache.neighbourhood(brick, t.c).bits;
     for (int q = 0; q < 4; ++q) {
       if (flags[v] & (1u << q)) continue;
       const auto [offset, edge] = cube::kCubesAroundSurfel[t.n][q];

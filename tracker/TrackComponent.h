@@ -5,6 +5,7 @@
 // images far too large to store.
 #pragma once
 
+#include <bit>
 #include <cstdint>
 #include <functional>
 #include <sstream>
@@ -82,11 +83,10 @@ template <class Cache, class F, class Crossed>
   follow(edges[2].result[(pattern >> 4) & 3]);
   follow(edges[3].result[pattern >> 6]);
   // Rule (iv); strictOnes / strictZeros never match when the pair has no such links.
-  if (const std::uint8_t candidates = steps.cubeCandidates(n, pattern)) {
+  if (unsigned candidates = steps.cubeCandidates(n, pattern)) [[unlikely]] {
     const std::uint32_t bits = slices.bits[0] | slices.bits[1] << 9 | slices.bits[2] << 18;
-    for (int q = 0; q < 4; ++q) {
-      if (!(candidates >> q & 1)) continue;
-      const auto& cube = steps.cubes(n)[q];
+    for (; candidates; candidates &= candidates - 1) {
+      const auto& cube = steps.cubes(n)[std::countr_zero(candidates)];
       const std::uint32_t m = bits & cube.mask;
       if (m == cube.strictOnes || m == cube.strictZeros)
         for (const BrickStep& link : cube.links[m == cube.strictOnes ? 0 : 1]) follow(link);
