@@ -29,14 +29,6 @@ namespace surftrack {
 
 namespace detail {
 
-/// The configuration of the cube with min corner c + offset, offset in {-1, 0}^3, from the
-/// 3x3x3 neighbourhood bits of voxel c (Neighbourhood::bitOf): its corners are the bits at
-/// bitOf(offset) + {0, 1, 3, 4, 9, 10, 12, 13}.
-inline std::uint8_t configurationFrom(std::uint32_t bits, Voxel offset) {
-  const std::uint32_t t = bits >> Neighbourhood::bitOf(offset);
-  return std::uint8_t((t & 3u) | ((t >> 3) & 3u) << 2 | ((t >> 9) & 3u) << 4 | ((t >> 12) & 3u) << 6);
-}
-
 [[noreturn]] inline void throwUnreachable(const Surfel& t, Voxel m, int edge) {
   std::ostringstream msg;
   msg << "extractLoops: the surface graph does not match the image: from " << t
@@ -133,12 +125,12 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
       brick = cache.brickIndex(brickOfT.x, brickOfT.y, brickOfT.z);
       lastBrick = brickOfT;
     }
-    const std::uint32_t around = cache.neighbourhood(brick, t.c).bits;
+    const Neighbourhood around = cache.neighbourhood(brick, t.c);
     for (int q = 0; q < 4; ++q) {
       if (flags[v] & (1u << q)) continue;
       const auto [offset, edge] = cube::kCubesAroundSurfel[t.n][q];
       const Voxel m = t.c + offset;
-      const std::uint8_t config = detail::configurationFrom(around, offset);
+      const std::uint8_t config = around.cubeConfiguration(offset);
       const CubeTriangulation& table = tables[config];
       const int patch = table.patchOfEdge[edge];
       if (patch < 0) detail::throwUnreachable(t, m, edge);

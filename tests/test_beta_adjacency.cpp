@@ -206,4 +206,18 @@ TEST(BrickStepTable, TrackerStepsAgreeWithDefinition38AtEveryPlaceOfABrick) {
   }
 }
 
+// The converter reads the 4 cubes around a surfel from its neighbourhood bits with shifts;
+// the reference reads the 8 corners one by one.
+TEST(Neighbourhood, CubeConfigurationsAgreeWithTheCornersOfEveryCube) {
+  std::mt19937 rng(27);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Neighbourhood around{Voxel{-3, 5, 11}, std::uint32_t(rng()) & ((1u << 27) - 1)};
+    for (int i = 0; i < cube::kCorners; ++i) {
+      const Voxel offset = cube::cornerOffset(i) - Voxel{1, 1, 1};
+      ASSERT_EQ(around.cubeConfiguration(offset), cube::configurationAt(around, around.center + offset))
+          << "neighbourhood " << around.bits << " offset " << offset;
+    }
+  }
+}
+
 }  // namespace

@@ -31,6 +31,14 @@ struct Neighbourhood {
   static constexpr int bitOf(Voxel d) { return (d.x + 1) + 3 * (d.y + 1) + 9 * (d.z + 1); }
   bool operator()(Voxel v) const { return (bits >> bitOf(v - center)) & 1u; }
   bool operator()(int x, int y, int z) const { return (*this)(Voxel{x, y, z}); }
+
+  /// The configuration byte (cube::configurationAt) of the digital 3-cube with min corner
+  /// center + offset, offset in {-1, 0}^3: its corners are the bits at bitOf(offset) +
+  /// {0, 1, 3, 4, 9, 10, 12, 13}, so four shifts read it.
+  std::uint8_t cubeConfiguration(Voxel offset) const {
+    const std::uint32_t t = bits >> bitOf(offset);
+    return std::uint8_t((t & 3u) | ((t >> 3) & 3u) << 2 | ((t >> 9) & 3u) << 4 | ((t >> 12) & 3u) << 6);
+  }
 };
 
 /// The 3x3x3 neighbourhood as three 9-bit z-slices, dz = -1, 0, +1.
