@@ -288,7 +288,7 @@ Row measure(const Options& o, int q, double noise) {
     TriangleMesh component = extractComponent(whole, seed);
     discard(whole);
     const SurfaceGraph graph = trackComponent(image, seed, o.pair);
-    TriangleMesh tracked = extractLoops(image, graph);
+    TriangleMesh tracked = extractLoops(graph);
     if (o.corrupt && !tracked.triangles.empty())
       std::swap(tracked.triangles[tracked.triangles.size() / 2][0],
                 tracked.triangles[tracked.triangles.size() / 2][1]);
@@ -347,7 +347,7 @@ Row measure(const Options& o, int q, double noise) {
       const Instant t0 = now();
       SurfaceGraph graph = trackComponent(image, seed, o.pair);
       const Instant t1 = now();
-      TriangleMesh tracked = extractLoops(image, graph);
+      TriangleMesh tracked = extractLoops(graph);
       const Instant t2 = now();
       const Span track = between(t0, t1), loops = between(t1, t2);
       row.track.add(track);

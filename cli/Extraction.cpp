@@ -158,7 +158,7 @@ void run(const DenseImage<T>& gray, const Binary& binary, const SurfaceOptions& 
     }
     clock.lap(x.timings, "track");
     progress.stage(stage++, stageCount, "converting to triangles");
-    triangles = extractLoops(binary, graph);
+    triangles = extractLoops(graph);  // from the bricks the tracker read: the same image
   }
   x.surfels = triangles.surfels.size();
 

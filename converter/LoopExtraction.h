@@ -90,15 +90,11 @@ inline void walkPatch(const SurfaceGraph& graph, Voxel m, std::uint8_t config, i
     }
 }
 
-}  // namespace detail
-
-/// The kappa-lambda-continuous analog of the boundary whose surface graph is `graph`, tracked in
-/// `image` with pair `graph.pair`, as an indexed mesh: vertex v is graph vertex v (same surfel,
-/// same order); triangles are oriented from the 1-voxels to the 0-voxels (§5.1).
-/// Throws std::logic_error if the graph does not match the image (a loop surfel that the
-/// arcs do not reach, or a vertex that is not a boundary surfel of the image).
-template <class BinaryImage>
-TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
+/// The loop algorithm over all vertices, reading cube configurations from `bricks`;
+/// findBrick(bx, by, bz) gives the index in `bricks` of the brick of voxels 8 (bx, by, bz) +
+/// [0, 8)^3 (binarising it if need be) or throws.
+template <class FindBrick>
+TriangleMesh extractLoops(const SurfaceGraph& graph, const BinaryBricks& bricks, FindBrick&& findBrick) {
   const std::vector<Surfel>& surfels = graph.surfels;
   const auto tables = configurationTables(graph.pair);
   const CubeLoops& loops = cubeLoops(graph.pair);
@@ -109,11 +105,9 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
   reserveHugePages(mesh.triangles, 2 * surfels.size() + 16);
   // flags[v] bit q: the patch of surfel v in cube cubesOf(surfels[v])[q] has been emitted.
   std::vector<std::uint8_t> flags(surfels.size(), 0);
-  // The 4 cubes around a surfel lie in the 3x3x3 neighbourhood of its 1-voxel: read them from
-  // a brick cache rather than voxel by voxel from the image.
-  // Tracked graphs number their vertices brick by brick, so the brick of the last surfel is
-  // almost always the brick of the next one: remember it rather than look it up.
-  BinaryBrickCache<BinaryImage> cache(image);
+  // The 4 cubes around a surfel lie in the 3x3x3 neighbourhood of its 1-voxel, which its brick
+  // holds. Tracked graphs number their vertices brick by brick, so the brick of the last
+  // surfel is almost always the brick of the next one: remember it rather than look it up.
   Voxel lastBrick{1 << 30, 0, 0};
   std::uint32_t brick = 0;
 
@@ -122,10 +116,10 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
     const Surfel& t = surfels[v];
     const Voxel brickOfT{t.c.x >> 3, t.c.y >> 3, t.c.z >> 3};
     if (brickOfT != lastBrick) [[unlikely]] {
-      brick = cache.brickIndex(brickOfT.x, brickOfT.y, brickOfT.z);
+      brick = findBrick(brickOfT.x, brickOfT.y, brickOfT.z);
       lastBrick = brickOfT;
     }
-    const Neighbourhood around = cache.neighbourhood(brick, t.c);
+    const Neighbourhood around = bricks.neighbourhood(brick, t.c);
     for (int q = 0; q < 4; ++q) {
       if (flags[v] & (1u << q)) continue;
       const auto [offset, edge] = cube::kCubesAroundSurfel[t.n][q];
@@ -164,6 +158,43 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
     }
   }
   return mesh;
+}
+
+}  // namespace detail
+
+/// The kappa-lambda-continuous analog of the boundary whose surface graph is `graph`, tracked in
+/// `image` with pair `graph.pair`, as an indexed mesh: vertex v is graph vertex v (same surfel,
+/// same order); triangles are oriented from the 1-voxels to the 0-voxels (§5.1). The cube
+/// configurations are read from `image`, so this also checks that the graph is a boundary of
+/// it: throws std::logic_error if not (a loop surfel that the arcs do not reach, or a vertex
+/// that is not a boundary surfel of the image).
+template <class BinaryImage>
+TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
+  BinaryBrickCache<BinaryImage> cache(image);
+  return detail::extractLoops(graph, cache.bricks(),
+                              [&](int bx, int by, int bz) { return cache.brickIndex(bx, by, bz); });
+}
+
+/// The same from the graph alone, with the cube configurations read from the bricks of the
+/// image that trackComponent keeps with the graph (SurfaceGraph::bricks): no second pass over
+/// the image. Throws std::invalid_argument for a graph that has vertices but no bricks (not made
+/// by trackComponent: use the overload with the image), std::logic_error if the graph does not
+/// match its bricks.
+inline TriangleMesh extractLoops(const SurfaceGraph& graph) {
+  if (graph.bricks.empty() && graph.surfelCount() != 0)
+    throw std::invalid_argument(
+        "extractLoops: this surface graph carries no image bricks (it was not made by "
+        "trackComponent); call extractLoops(image, graph)");
+  return detail::extractLoops(graph, graph.bricks, [&](int bx, int by, int bz) {
+    const std::uint32_t b = graph.bricks.find(bx, by, bz);
+    if (b == BinaryBricks::kMissing) {
+      std::ostringstream msg;
+      msg << "extractLoops: the surface graph has a vertex in brick " << Voxel{bx, by, bz}
+          << " (voxels 8x that + [0,8)^3), which its bricks do not hold";
+      throw std::logic_error(msg.str());
+    }
+    return b;
+  });
 }
 
 }  // namespace surftrack

@@ -237,6 +237,8 @@ ImageStats checkImage(const BinaryVolume& volume, AdjacencyPair pair, Checks che
     const SurfaceGraph graph = trackComponent(image, boundary.front(), pair);
     const TriangleMesh mesh = extractLoops(image, graph);
     EXPECT_EQ(mesh.surfels, graph.surfels) << "vertex v must be graph vertex v";
+    EXPECT_EQ(extractLoops(graph).triangles, mesh.triangles)
+        << "the bricks the graph keeps must give the triangles the image gives";
     long euler = 0;
     const auto manifold = isClosedManifoldOn(mesh, keys, &euler);
     EXPECT_TRUE(manifold);
@@ -341,6 +343,16 @@ TEST(LoopExtractionErrors, GraphOfAnotherImageIsRejected) {
   SurfaceGraph split = trackComponent(image, Surfel{{0, 0, 0}, 1}, AdjacencyPair::k18_6);
   split.pair = AdjacencyPair::k26_6;
   EXPECT_THROW(extractLoops(image, split), std::logic_error);
+  EXPECT_THROW(extractLoops(split), std::logic_error);
+  // A graph that carries no bricks can only be checked against an image.
+  SurfaceGraph bare = graph;
+  bare.bricks = {};
+  EXPECT_THROW(extractLoops(bare), std::invalid_argument);
+  EXPECT_NO_THROW(extractLoops(image, bare));
+  // A vertex moved to a brick the graph's bricks do not hold.
+  SurfaceGraph moved = graph;
+  moved.surfels[0].c.x += 64;
+  EXPECT_THROW(extractLoops(moved), std::logic_error);
   // A voxel of the tracked surface removed.
   BinaryVolume b = a;
   b.at(1, 1, 1) = 0;
@@ -366,6 +378,10 @@ TEST(LoopExtractionCost, ReadsVoxelsInProportionToTheSurfaceOnly) {
   const TriangleMesh mesh = extractLoops(ball, graph);
   EXPECT_LE(reads, 4 * 8 * graph.surfelCount());
   EXPECT_TRUE(isClosedManifoldOn(mesh, ref::sortedKeys(graph.surfels)));
+  // From the bricks the graph keeps, the image is not read at all.
+  reads = 0;
+  EXPECT_EQ(extractLoops(graph).triangles, mesh.triangles);
+  EXPECT_EQ(reads, 0u);
 }
 
 // ---------------------------------------------------------------------------------------------

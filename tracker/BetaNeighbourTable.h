@@ -9,7 +9,7 @@
 
 #include "AdjacencyPair.h"
 #include "BetaAdjacency.h"
-#include "BinaryBrickCache.h"
+#include "BinaryBricks.h"
 
 namespace surftrack {
 

@@ -8,6 +8,7 @@
 #include <boost/graph/compressed_sparse_row_graph.hpp>
 
 #include "AdjacencyPair.h"
+#include "BinaryBricks.h"
 #include "Surfel.h"
 
 namespace surftrack {
@@ -24,6 +25,11 @@ struct SurfaceGraph {
   AdjacencyPair pair = AdjacencyPair::k26_6;
   std::vector<Surfel> surfels;  ///< surfels[v] is the surfel of vertex v
   SurfelGraph graph;
+  /// The image near the surface, as the tracker read it: the bricks that hold the surfels'
+  /// 1-voxels, with their aprons. The converter takes the cube configurations from here
+  /// (extractLoops(graph)), so it need not read the image again. Empty for graphs not made by
+  /// trackComponent.
+  BinaryBricks bricks;
 
   std::size_t surfelCount() const { return surfels.size(); }
   /// Number of beta-arcs (each undirected arc counted once).

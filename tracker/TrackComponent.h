@@ -166,6 +166,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
     rowStart[++v] = a;
   });
   result.graph = makeSurfelGraph(std::move(rowStart), std::move(targets));
+  result.bricks = std::move(cache).release();
   return result;
 }
 
