@@ -6,7 +6,13 @@
 // the baseline issue 2 names, a hash-set depth-first traversal (HashSetTraversal.h), and
 // prints the speed ratio: absolute speeds drift between runs on a VM, the ratio much less.
 //
+// With --breakdown, two parts of the tracker's work are also timed on their own, each in the
+// same kind of child process: binarising the bricks the surface passes through (the tracker's
+// BinaryBrickCache, in the order it created them), and writing fresh output arrays of the graph's
+// size (surfels, row starts, arcs: the floor any tracker writing this graph pays).
+//
 //   bench_tracking [--sizes 64,128,...] [--quick] [--reps N] [--pair 26-6] [--no-baseline]
+//                  [--breakdown]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -94,6 +100,37 @@ void printRow(const std::string& name, const Measurement& m, const Measurement& 
   std::fflush(stdout);
 }
 
+// The --breakdown parts for the graph `g` tracked in `image`: binarising its bricks, and
+// writing output arrays of its size. Printed on one line below the case's row.
+template <class BinaryImage>
+void printBreakdown(int runs, const BinaryImage& image, const SurfaceGraph& g, const Measurement& whole) {
+  const Measurement bricks = measure(runs, [&] {
+    BinaryBrickCache<BinaryImage> cache(image);
+    for (std::uint32_t b = 0; b < g.bricks.size(); ++b) {
+      const Voxel o = g.bricks.brickOrigin(b);
+      cache.brickIndex(o.x >> 3, o.y >> 3, o.z >> 3);
+    }
+    return g.surfelCount();
+  });
+  const Measurement output = measure(runs, [&] {
+    const std::size_t n = g.surfelCount(), arcs = boost::num_edges(g.graph);
+    std::vector<Surfel> surfels;
+    std::vector<std::uint32_t> rowStart, targets;
+    resizeHugePages(surfels, n);
+    resizeHugePages(rowStart, n + 1);
+    resizeHugePages(targets, arcs);
+    for (std::size_t v = 0; v < n; ++v) surfels[v] = Surfel{Voxel{int(v), 0, 0}, 0}, rowStart[v] = std::uint32_t(v);
+    for (std::size_t a = 0; a < arcs; ++a) targets[a] = std::uint32_t(a);
+    return n;
+  });
+  const double rest = whole.cpuSeconds - bricks.cpuSeconds - output.cpuSeconds;
+  std::printf("    breakdown (cpu ms): binarise %zu bricks %.1f, write output %.1f, the rest %.1f "
+              "(%.0f ns/surfel)\n",
+              g.bricks.size(), 1e3 * bricks.cpuSeconds, 1e3 * output.cpuSeconds, 1e3 * rest,
+              1e9 * rest / double(g.surfelCount()));
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -101,7 +138,7 @@ int main(int argc, char** argv) {
     std::vector<int> sizes{64, 128, 256, 512, 1024};
     int reps = 5;
     AdjacencyPair pair = AdjacencyPair::k26_6;
-    bool implicitBall = true, baseline = true;
+    bool implicitBall = true, baseline = true, breakdown = false;
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
       auto value = [&]() -> std::string {
@@ -113,6 +150,7 @@ int main(int argc, char** argv) {
       else if (a == "--reps") reps = std::stoi(value());
       else if (a == "--pair") pair = parseAdjacencyPair(value());
       else if (a == "--no-baseline") baseline = false;
+      else if (a == "--breakdown") breakdown = true;
       else throw std::invalid_argument("unknown option " + a);
     }
     std::printf("trackComponent throughput, pair %s, median of %d runs, one thread\n",
@@ -130,6 +168,7 @@ int main(int argc, char** argv) {
         const Measurement b = baseline ? measure(runs, [&] { return bench::hashSetTraversal(image, seed, pair); })
                                        : Measurement{};
         printRow("sphere q=" + std::to_string(q) + " p=" + std::to_string(int(noise * 100)) + "%", m, b);
+        if (breakdown) printBreakdown(runs, image, trackComponent(image, seed, pair), m);
       }
     if (implicitBall) {
       const int c = 2048, radius = 900;
@@ -144,6 +183,7 @@ int main(int argc, char** argv) {
       const Measurement b = baseline ? measure(runs, [&] { return bench::hashSetTraversal(ball, seed, pair); })
                                      : Measurement{};
       printRow("implicit ball R=900 in 4096^3", m, b);
+      if (breakdown) printBreakdown(runs, ball, trackComponent(ball, seed, pair), m);
     }
     return 0;
   } catch (const std::exception& e) {
