@@ -15,7 +15,7 @@ set logscale y
 set ylabel 'time ratio (log scale)'
 set format y '%g'
 set xrange [0:*]
-set yrange [0.0222222:37.5299]
+set yrange [0.0222222:38.0314]
 set arrow 1 from graph 0, first 0.1 to graph 1, first 0.1 nohead lc rgb '#888888' dt 2
 set label 1 'target 1/10 (no noise)' at graph 0.01, first 0.115 tc rgb '#666666'
 set arrow 2 from graph 0, first (1.0/30) to graph 1, first (1.0/30) nohead lc rgb '#888888' dt 2
@@ -43,26 +43,26 @@ set logscale xy
 set xrange [*:*]
 set ylabel 'time (ms)'
 set key top left Left reverse font 'Sans,9'
-f0_0(x) = exp(-10.1455 + 2.25792 * log(x))
-f0_1(x) = exp(-8.41602 + 2.03532 * log(x))
-f0_2(x) = exp(-7.97397 + 2.05516 * log(x))
-f1_0(x) = exp(-12.311 + 2.85498 * log(x))
-f1_1(x) = exp(-10.5286 + 2.61579 * log(x))
-f1_2(x) = exp(-8.41762 + 2.14677 * log(x))
-f2_0(x) = exp(-12.3336 + 3.03412 * log(x))
-f2_1(x) = exp(-11.1742 + 2.91307 * log(x))
-f2_2(x) = exp(-7.97353 + 2.10338 * log(x))
-plot 'figure9-plot.dat' index 0 using 1:2 with points lc rgb '#1f4e99' pt 5 ps 1.2 title 'method 1, 0% noise: slope 2.26', \
+f0_0(x) = exp(-10.9979 + 2.38244 * log(x))
+f0_1(x) = exp(-9.25356 + 2.15572 * log(x))
+f0_2(x) = exp(-8.81934 + 2.18023 * log(x))
+f1_0(x) = exp(-12.9544 + 2.94895 * log(x))
+f1_1(x) = exp(-11.0513 + 2.68582 * log(x))
+f1_2(x) = exp(-8.82465 + 2.19573 * log(x))
+f2_0(x) = exp(-12.6641 + 3.08047 * log(x))
+f2_1(x) = exp(-11.4709 + 2.9628 * log(x))
+f2_2(x) = exp(-8.24226 + 2.12717 * log(x))
+plot 'figure9-plot.dat' index 0 using 1:2 with points lc rgb '#1f4e99' pt 5 ps 1.2 title 'method 1, 0% noise: slope 2.38', \
      [64:*] f0_0(x) with lines lc rgb '#1f4e99' dt 1 notitle, \
-     'figure9-plot.dat' index 1 using 1:2 with points lc rgb '#c2410c' pt 5 ps 1.2 title 'method 1, 1% noise: slope 2.85', \
+     'figure9-plot.dat' index 1 using 1:2 with points lc rgb '#c2410c' pt 5 ps 1.2 title 'method 1, 1% noise: slope 2.95', \
      [64:*] f1_0(x) with lines lc rgb '#c2410c' dt 1 notitle, \
-     'figure9-plot.dat' index 2 using 1:2 with points lc rgb '#15803d' pt 5 ps 1.2 title 'method 1, 5% noise: slope 3.03', \
+     'figure9-plot.dat' index 2 using 1:2 with points lc rgb '#15803d' pt 5 ps 1.2 title 'method 1, 5% noise: slope 3.08', \
      [64:*] f2_0(x) with lines lc rgb '#15803d' dt 1 notitle, \
-     'figure9-plot.dat' index 0 using 1:4 with points lc rgb '#1f4e99' pt 9 ps 1.2 title 'method 2, 0% noise: slope 2.06', \
+     'figure9-plot.dat' index 0 using 1:4 with points lc rgb '#1f4e99' pt 9 ps 1.2 title 'method 2, 0% noise: slope 2.18', \
      [64:*] f0_2(x) with lines lc rgb '#1f4e99' dt 2 notitle, \
-     'figure9-plot.dat' index 1 using 1:4 with points lc rgb '#c2410c' pt 9 ps 1.2 title 'method 2, 1% noise: slope 2.15', \
+     'figure9-plot.dat' index 1 using 1:4 with points lc rgb '#c2410c' pt 9 ps 1.2 title 'method 2, 1% noise: slope 2.20', \
      [64:*] f1_2(x) with lines lc rgb '#c2410c' dt 2 notitle, \
-     'figure9-plot.dat' index 2 using 1:4 with points lc rgb '#15803d' pt 9 ps 1.2 title 'method 2, 5% noise: slope 2.10', \
+     'figure9-plot.dat' index 2 using 1:4 with points lc rgb '#15803d' pt 9 ps 1.2 title 'method 2, 5% noise: slope 2.13', \
      [64:*] f2_2(x) with lines lc rgb '#15803d' dt 2 notitle
 set title '(d) throughput of method 1 (scanning the whole image)'
 set logscale x
