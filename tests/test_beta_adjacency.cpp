@@ -195,8 +195,7 @@ TEST(BrickStepTable, TrackerStepsAgreeWithDefinition38AtEveryPlaceOfABrick) {
                 const Voxel local{v & 7, (v >> 3) & 7, v >> 6};
                 const Voxel offset{8 * (s % 3 - 1), 8 * ((s / 3) % 3 - 1), 8 * (s / 9 - 1)};
                 found.push_back(Surfel{t.c + offset + local - place, Direction(to >> 9)});
-              },
-              [] {});
+              });
           ASSERT_EQ(int(found.size()), k) << toString(pair) << " neighbourhood " << bits;
           for (int j = 0; j < k; ++j)
             ASSERT_EQ(found[j], expected[j]) << toString(pair) << " neighbourhood " << bits << " place " << place;

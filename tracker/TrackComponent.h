@@ -53,14 +53,16 @@ namespace detail {
 // The per-arc lambdas of the traversal must be inlined: as calls they double its cost.
 #define SURFTRACK_INLINE __attribute__((always_inline))
 
+/// The most bricks forEachBetaNeighbour can create for one surfel: its neighbours lie in the
+/// 26 bricks around its own, but only in those that share the corner its voxel is nearest to.
+inline constexpr std::size_t kMaxBricksCreatedPerSurfel = 7;
+
 /// Calls f(brick, slot) for each beta-neighbour of the surfel in `slot` of brick b, in the
 /// order of betaNeighbours. Neighbours in other bricks come through cache.linkedBrick, which
-/// creates (binarises) a brick on first use; `crossed` is called after that may have happened,
-/// before f, so that per-brick state can grow with the cache.
-template <class Cache, class F, class Crossed>
+/// creates (binarises) up to kMaxBricksCreatedPerSurfel bricks on first use.
+template <class Cache, class F>
 [[gnu::always_inline]] inline void forEachBetaNeighbour(Cache& cache, const BrickStepTable& steps,
-                                                        std::uint32_t b, int slot, F&& f,
-                                                        Crossed&& crossed) {
+                                                        std::uint32_t b, int slot, F&& f) {
   const int voxel = slot & 511;
   const NeighbourhoodSlices slices = cache.neighbourhoodSlices(b, voxel);
   const std::uint8_t border = brickslot::kBorderFlags[voxel];
@@ -70,7 +72,6 @@ template <class Cache, class F, class Crossed>
       const int x = (voxel & 7) + step.dx, y = ((voxel >> 3) & 7) + step.dy, z = (voxel >> 6) + step.dz;
       const std::uint32_t brick =
           cache.linkedBrick(b, ((x + 8) >> 3) + 3 * ((y + 8) >> 3) + 9 * ((z + 8) >> 3));
-      crossed();
       f(brick, brickslot::slotOf(brickslot::voxelOf(x & 7, y & 7, z & 7), step.n));
     } else {
       f(b, slot + step.deltaSlot);
@@ -127,6 +128,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
     queue.push(std::uint64_t(b) << 12 | std::uint64_t(slot));
     while (!queue.empty()) {
       queue.reserve(kMaxBetaNeighbours);
+      visited.resize(cache.brickCount() + detail::kMaxBricksCreatedPerSurfel);
       const std::uint64_t entry = queue.pop();
       detail::forEachBetaNeighbour(
           cache, steps, std::uint32_t(entry >> 12), int(entry & 4095),
@@ -137,8 +139,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
             const bool reached = !(w & m);
             w |= m;
             queue.pushIf(std::uint64_t(to) << 12 | std::uint64_t(toSlot), reached);
-          },
-          [&] { visited.resize(cache.brickCount()); });
+          });
       if (progress && queue.pushed() >= nextReport) {
         progress(queue.pushed());
         nextReport += std::size_t(1) << 20;
@@ -161,8 +162,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
                                Direction(slot >> 9)};
     detail::forEachBetaNeighbour(
         cache, steps, brick, slot,
-        [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE { targets[a++] = visited.index(to, toSlot); },
-        [] {});
+        [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE { targets[a++] = visited.index(to, toSlot); });
     rowStart[++v] = a;
   });
   result.graph = makeSurfelGraph(std::move(rowStart), std::move(targets));
