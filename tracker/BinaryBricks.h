@@ -54,8 +54,6 @@ class BinaryBricks {
     std::uint16_t spare[3];  // read, never used, by neighbourhoodSlices' last 64-bit load
   };
 
-  BinaryBricks() { rehash(1024); }
-
   std::size_t size() const { return bricks_.size(); }
   bool empty() const { return bricks_.empty(); }
 
@@ -66,6 +64,7 @@ class BinaryBricks {
 
   /// The index of the brick of voxels 8 (bx, by, bz) + [0, 8)^3, or kMissing.
   std::uint32_t find(std::uint64_t key) const {
+    if (slots_.empty()) return kMissing;
     for (std::size_t i = mix64(key) & mask_; slots_[i].key != kEmpty; i = (i + 1) & mask_)
       if (slots_[i].key == key) return slots_[i].brick;
     return kMissing;
@@ -75,7 +74,7 @@ class BinaryBricks {
   /// Adds a brick whose key is not yet present; returns its index (bricks are numbered in the
   /// order they are added).
   std::uint32_t insert(const Brick& brick) {
-    if (2 * (bricks_.size() + 1) > slots_.size()) rehash(2 * slots_.size());
+    if (2 * (bricks_.size() + 1) > slots_.size()) rehash(std::max<std::size_t>(1024, 2 * slots_.size()));
     std::size_t i = mix64(brick.key) & mask_;
     while (slots_[i].key != kEmpty) i = (i + 1) & mask_;
     slots_[i] = {brick.key, std::uint32_t(bricks_.size())};
