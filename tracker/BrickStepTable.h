@@ -68,7 +68,6 @@ class BrickStepTable {
       }
       computeCandidates(n);
       computeSlicePatterns(n);
-      computeInBrickMoves(n);
     }
   }
 
@@ -76,13 +75,6 @@ class BrickStepTable {
   /// the pair, given the rule indices a | b << 1 of its 4 edges packed 2 bits each: the 4 of
   /// the cube's 6 other corners that are edge voxels already decide it in almost every case.
   std::uint8_t cubeCandidates(Direction n, int edgePattern) const { return candidates_[n][edgePattern]; }
-
-  /// For the 4 edge neighbours given by an edge pattern: the border flags (BrickSlot.h) for which
-  /// one of them lies in another brick, and, for when none does, their 4 slot offsets as int16
-  /// fields of one word. Most surfels are not on the border they move across, so their
-  /// neighbours are 4 additions.
-  std::uint8_t crossMask(Direction n, int edgePattern) const { return crossMask_[n][edgePattern]; }
-  std::uint64_t inBrickMoves(Direction n, int edgePattern) const { return inBrickMoves_[n][edgePattern]; }
 
   /// The rule indices a | b << 1 of the 4 edges of a surfel with normal n, packed 2 bits each,
   /// from its neighbourhood's three 9-bit z-slices: three table look-ups instead of eight bit
@@ -112,15 +104,6 @@ class BrickStepTable {
       }
   }
 
-  void computeInBrickMoves(Direction n) {
-    for (int pattern = 0; pattern < 256; ++pattern)
-      for (int k = 0; k < 4; ++k) {
-        const BrickStep& step = edges_[n][k].result[(pattern >> (2 * k)) & 3];
-        crossMask_[n][pattern] |= step.crossMask;
-        inBrickMoves_[n][pattern] |= std::uint64_t(std::uint16_t(step.deltaSlot)) << (16 * k);
-      }
-  }
-
   void computeCandidates(Direction n) {
     std::uint32_t edgeBits = 0;
     for (const EdgeSteps& e : edges_[n]) edgeBits |= 1u << e.aBit | 1u << e.bBit;
@@ -141,8 +124,6 @@ class BrickStepTable {
   }
 
   std::array<std::array<std::uint8_t, 256>, 6> candidates_{};
-  std::array<std::array<std::uint8_t, 256>, 6> crossMask_{};
-  std::array<std::array<std::uint64_t, 256>, 6> inBrickMoves_{};
   std::array<std::array<std::array<std::uint8_t, 512>, 3>, 6> slicePatterns_{};
   std::array<std::array<EdgeSteps, 4>, 6> edges_{};
   std::array<std::array<CubeSteps, 4>, 6> cubes_{};

@@ -78,19 +78,11 @@ template <class Cache, class F>
     }
   };
   const int pattern = steps.edgePattern(n, slices.bits);
-  if (!(border & steps.crossMask(n, pattern))) [[likely]] {
-    const std::uint64_t moves = steps.inBrickMoves(n, pattern);
-    f(b, slot + std::int16_t(moves));
-    f(b, slot + std::int16_t(moves >> 16));
-    f(b, slot + std::int16_t(moves >> 32));
-    f(b, slot + std::int16_t(moves >> 48));
-  } else {
-    const auto& edges = steps.edges(n);
-    follow(edges[0].result[pattern & 3]);
-    follow(edges[1].result[(pattern >> 2) & 3]);
-    follow(edges[2].result[(pattern >> 4) & 3]);
-    follow(edges[3].result[pattern >> 6]);
-  }
+  const auto& edges = steps.edges(n);
+  follow(edges[0].result[pattern & 3]);
+  follow(edges[1].result[(pattern >> 2) & 3]);
+  follow(edges[2].result[(pattern >> 4) & 3]);
+  follow(edges[3].result[pattern >> 6]);
   // Rule (iv); strictOnes / strictZeros never match when the pair has no such links.
   if (unsigned candidates = steps.cubeCandidates(n, pattern)) [[unlikely]] {
     const std::uint32_t bits = slices.bits[0] | slices.bits[1] << 9 | slices.bits[2] << 18;
