@@ -127,13 +127,13 @@ TriangleMesh extractLoops(const SurfaceGraph& graph, const BinaryBricks& bricks,
       const std::uint8_t config = around.cubeConfiguration(offset);
       const CubeTriangulation& table = tables[config];
       const int patch = table.patchOfEdge[edge];
-      if (patch < 0) detail::throwUnreachable(t, m, edge);
+      if (patch < 0) throwUnreachable(t, m, edge);
 
       // A loop (almost always): walk it and emit its triangles by loop position.
       const CubeLoop& loop = loops[config][patch];
       std::array<std::uint32_t, cube::kEdges> byPosition;
       if (loop.length != 0 &&
-          detail::walkLoop(graph, m, onEdges[config], loop, loop.positionOf[edge], v, byPosition)) {
+          walkLoop(graph, m, onEdges[config], loop, loop.positionOf[edge], v, byPosition)) {
         for (int i = 0; i < loop.triangleCount; ++i) {
           const auto& tri = loop.triangles[i];
           mesh.triangles.push_back({byPosition[tri[0]], byPosition[tri[1]], byPosition[tri[2]]});
@@ -143,12 +143,12 @@ TriangleMesh extractLoops(const SurfaceGraph& graph, const BinaryBricks& bricks,
       }
 
       // The strict-26 tube, or a graph that does not match the image (which this reports).
-      detail::PatchVertices patchVertices;
-      detail::walkPatch(graph, m, config, patch, table, v, patchVertices);
+      PatchVertices patchVertices;
+      walkPatch(graph, m, config, patch, table, v, patchVertices);
       for (const auto& tri : table.patchTriangles(patch)) {
         const std::int32_t a = patchVertices.onEdge[tri[0]], b = patchVertices.onEdge[tri[1]],
                            c = patchVertices.onEdge[tri[2]];
-        if ((a | b | c) < 0) detail::throwUnreachable(t, m, a < 0 ? tri[0] : b < 0 ? tri[1] : tri[2]);
+        if ((a | b | c) < 0) throwUnreachable(t, m, a < 0 ? tri[0] : b < 0 ? tri[1] : tri[2]);
         mesh.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
       }
       for (int i = 0; i < patchVertices.count; ++i) {

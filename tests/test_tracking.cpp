@@ -43,6 +43,7 @@ TEST(Tracking, ImplicitBallOfRadius900InA4096CubedDomain) {
   // Progress: about once per 2^20 surfels found, increasing, never past the total.
   EXPECT_GE(reports.size(), g.surfelCount() / (std::size_t(1) << 20) - 1);
   EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
+  ASSERT_FALSE(reports.empty());
   EXPECT_LE(reports.back(), g.surfelCount());
 }
 

@@ -29,15 +29,11 @@ class BinaryBrickCache {
   /// Hands the bricks over (to the surface graph); the cache is empty afterwards.
   BinaryBricks release() && { return std::move(bricks_); }
 
-  /// The 3x3x3 neighbourhood of voxel u.
-  Neighbourhood neighbourhood(Voxel u) { return bricks_.neighbourhood(brickOf(u), u); }
-  Neighbourhood neighbourhood(std::uint32_t brick, Voxel u) const { return bricks_.neighbourhood(brick, u); }
+  /// BinaryBricks::neighbourhoodSlices, for forEachBetaNeighbour (which tests drive with a
+  /// fixed neighbourhood instead of a cache).
   NeighbourhoodSlices neighbourhoodSlices(std::uint32_t brick, int voxel) const {
     return bricks_.neighbourhoodSlices(brick, voxel);
   }
-  Voxel brickOrigin(std::uint32_t b) const { return bricks_.brickOrigin(b); }
-  std::vector<std::uint32_t> bricksInSpaceOrder() const { return bricks_.bricksInSpaceOrder(); }
-  std::size_t brickCount() const { return bricks_.size(); }
 
   /// The brick next to brick b at offset (sx-1, sy-1, sz-1), selector s = sx + 3 sy + 9 sz in
   /// [0, 27) (13 is b itself); created on first use. Links are remembered both ways, so the
@@ -45,7 +41,7 @@ class BinaryBrickCache {
   std::uint32_t linkedBrick(std::uint32_t b, int s) {
     std::uint32_t l = links_[b][s];
     if (l != kNoLink) return l;
-    const Voxel o = brickOrigin(b);
+    const Voxel o = bricks_.brickOrigin(b);
     l = brickIndex((o.x >> 3) + s % 3 - 1, (o.y >> 3) + (s / 3) % 3 - 1, (o.z >> 3) + s / 9 - 1);
     links_[b][s] = l;
     links_[l][26 - s] = b;

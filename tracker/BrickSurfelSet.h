@@ -24,16 +24,14 @@ class BrickSurfelSet {
     if (count > words_.size()) resizeHugePages(words_, count);
   }
 
-  /// The 48 words of a brick made room for (invalidated by resize).
-  std::uint64_t* words(std::uint32_t brick) { return words_[brick].data(); }
-
-  /// Marks the surfel of a brick made room for; false if it was already marked.
+  /// Marks the surfel of a brick made room for; false if it was already marked. Without a
+  /// branch: the tracker calls it on every arc, and whether a surfel is new is unpredictable.
   bool insert(std::uint32_t brick, int bit) {
     std::uint64_t& w = words_[brick][bit >> 6];
     const std::uint64_t m = std::uint64_t(1) << (bit & 63);
-    if (w & m) return false;
+    const bool fresh = !(w & m);
     w |= m;
-    return true;
+    return fresh;
   }
 
   /// Freezes the set and numbers its surfels, brick by brick in the given order (every brick

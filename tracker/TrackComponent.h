@@ -123,22 +123,18 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
     const Voxel c = seed.inside();
     const std::uint32_t b = cache.brickOf(c);
     const int slot = brickslot::slotOf(brickslot::voxelOf(c.x & 7, c.y & 7, c.z & 7), seed.n);
-    visited.resize(cache.brickCount());
+    visited.resize(cache.bricks().size());
     visited.insert(b, slot);
     queue.push(std::uint64_t(b) << 12 | std::uint64_t(slot));
     while (!queue.empty()) {
       queue.reserve(kMaxBetaNeighbours);
-      visited.resize(cache.brickCount() + detail::kMaxBricksCreatedPerSurfel);
+      visited.resize(cache.bricks().size() + detail::kMaxBricksCreatedPerSurfel);
       const std::uint64_t entry = queue.pop();
       detail::forEachBetaNeighbour(
           cache, steps, std::uint32_t(entry >> 12), int(entry & 4095),
           [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE {
             ++arcs;
-            std::uint64_t& w = visited.words(to)[toSlot >> 6];
-            const std::uint64_t m = std::uint64_t(1) << (toSlot & 63);
-            const bool reached = !(w & m);
-            w |= m;
-            queue.pushIf(std::uint64_t(to) << 12 | std::uint64_t(toSlot), reached);
+            queue.pushIf(std::uint64_t(to) << 12 | std::uint64_t(toSlot), visited.insert(to, toSlot));
           });
       if (progress && queue.pushed() >= nextReport) {
         progress(queue.pushed());
@@ -148,7 +144,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
   }
 
   // 2. Vertices by rank, arcs by recomputing each vertex's neighbours.
-  const std::uint32_t count = visited.number(cache.bricksInSpaceOrder());
+  const std::uint32_t count = visited.number(cache.bricks().bricksInSpaceOrder());
   SurfaceGraph result;
   result.pair = pair;
   resizeHugePages(result.surfels, count);
@@ -158,7 +154,7 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
   std::uint32_t v = 0, a = 0;
   visited.forEach([&](std::uint32_t brick, int slot) SURFTRACK_INLINE {
     const int voxel = slot & 511;
-    result.surfels[v] = Surfel{cache.brickOrigin(brick) + Voxel{voxel & 7, (voxel >> 3) & 7, voxel >> 6},
+    result.surfels[v] = Surfel{cache.bricks().brickOrigin(brick) + Voxel{voxel & 7, (voxel >> 3) & 7, voxel >> 6},
                                Direction(slot >> 9)};
     detail::forEachBetaNeighbour(
         cache, steps, brick, slot,
