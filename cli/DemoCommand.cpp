@@ -66,7 +66,7 @@ Extraction extract(const io::AnyVolume& volume, const std::string& inputName, co
   StageClock clock;
   x.timings.push_back({"read", readSeconds});
   describeInput(volume, inputName, x);
-  const int stages = 5;
+  const int stages = extractionStages(options) + 1;  // + write
   extractSurface(volume, options, x, clock, progress, 0, stages);
   progress.stage(stages - 1, stages, "writing " + output);
   x.bytes = writeMeshFile(x.mesh, output, x.binary);

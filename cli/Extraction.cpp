@@ -6,11 +6,7 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "BoundaryMapping.h"
-#include "FindSeed.h"
-#include "LoopExtraction.h"
-#include "ScanIsoSurface.h"
-#include "TrackComponent.h"
+#include "Extract.h"
 #include "VolumeStats.h"
 
 namespace surftrack::cli {
@@ -24,167 +20,31 @@ std::string formatNumber(double v) {
   return s.str();
 }
 
-std::string domainText(const Dims& d) {
-  std::ostringstream s;
-  s << "[0," << d.nx << ")x[0," << d.ny << ")x[0," << d.nz << ")";
-  return s.str();
+/// The core's view of a volume read by io/ (no copy).
+VolumeView viewOf(const io::AnyVolume& volume) {
+  return std::visit(
+      [](const auto& image) { return VolumeView::of(image.data().data(), image.dims(), image.geometry()); },
+      volume);
 }
 
-/// The label as a value of T; throws if T cannot hold it exactly.
-template <class T>
-T labelValue(double label, const std::string& input) {
-  if constexpr (std::is_integral_v<T>) {
-    if (label != std::floor(label) || label < double(std::numeric_limits<T>::min()) ||
-        label > double(std::numeric_limits<T>::max()))
-      throw std::runtime_error("label " + formatNumber(label) + " is not a value of the integer image '" +
-                               input + "'");
-    return T(label);
-  } else {
-    return T(label);
+SeedRule seedRuleOf(const SurfaceOptions& o) {
+  switch (o.seedMode) {
+    case SeedMode::All: return SeedRule::all();
+    case SeedMode::Largest: return SeedRule::largest();
+    case SeedMode::Voxel: return SeedRule::fromVoxel(o.seedVoxel);
+    case SeedMode::Point: return SeedRule::point(o.seedPoint);
+    case SeedMode::Surfel: break;
   }
+  return SeedRule::fromSurfel(Surfel{o.seedVoxel, o.seedDirection});
 }
 
-/// The seed rule for a voxel: a 1-voxel walks to the first 1->0 step, a 0-voxel to the first
-/// 0->1 step, along +x, then -x, +y, -y, +z, -z (seedAlongRay).
-template <class Binary>
-void resolveVoxelSeed(const Binary& binary, Voxel v, Extraction& x) {
-  const Dims& dims = binary.dims();
-  if (!dims.contains(v)) {
-    std::ostringstream msg;
-    msg << "seed voxel " << v << " lies outside the image domain " << domainText(dims);
-    if (x.seedPoint)
-      msg << " (the seed point (" << formatNumber((*x.seedPoint)[0]) << ","
-          << formatNumber((*x.seedPoint)[1]) << "," << formatNumber((*x.seedPoint)[2])
-          << ") is outside the image)";
-    throw std::runtime_error(msg.str());
-  }
-  x.seedVoxel = v;
-  x.seedVoxelInside = binary(v);
-  for (Direction d = 0; d < 6; ++d) {
-    if (auto s = seedAlongRay(binary, v, d)) {
-      x.walkDirection = d;
-      const Voxel delta = s->inside() - v;
-      x.walkSteps = std::abs(delta.x) + std::abs(delta.y) + std::abs(delta.z);
-      x.seedSurfel = *s;
-      return;
-    }
-  }
-  std::ostringstream msg;
-  msg << "seed voxel " << v << " is not on any boundary: it is a 0-voxel and no 1-voxel lies on "
-      << "the six axis rays from it";
-  throw std::runtime_error(msg.str());
-}
-
-template <class T, class Binary>
-void run(const DenseImage<T>& gray, const Binary& binary, const SurfaceOptions& o, Extraction& x,
-         StageClock& clock, Progress& progress, int stage, int stageCount) {
-  const ImageGeometry& geometry = gray.geometry();
-  TriangleMesh triangles;
-  if (o.seedMode == SeedMode::All) {
-    progress.stage(stage++, stageCount, "scanning every boundary");
-    triangles = scanIsoSurface(binary, o.pair);
-    std::size_t count = 0;
-    meshComponents(triangles, count);
-    x.boundaries = count;
-    clock.lap(x.timings, "scan");
-    if (triangles.surfels.empty())
-      throw std::runtime_error("empty selection: the image has no boundary surfel");
-    progress.stage(stage++, stageCount, "building the mesh");
-  } else {
-    progress.stage(stage++, stageCount, "finding the seed");
-    switch (o.seedMode) {
-      case SeedMode::Largest: {
-        const TriangleMesh all = scanIsoSurface(binary, o.pair);
-        std::size_t count = 0;
-        const std::vector<std::uint32_t> component = meshComponents(all, count);
-        if (count == 0) throw std::runtime_error("empty selection: the image has no boundary surfel");
-        std::vector<std::size_t> size(count, 0);
-        for (std::uint32_t c : component) ++size[c];
-        std::size_t best = 0;
-        for (std::size_t c = 1; c < count; ++c)
-          if (size[c] > size[best]) best = c;
-        for (std::size_t v = 0; v < component.size(); ++v)
-          if (component[v] == best) {
-            x.seedSurfel = all.surfels[v];
-            break;
-          }
-        x.boundaries = count;
-        x.surfels = size[best];  // checked against the tracked count below
-        break;
-      }
-      case SeedMode::Voxel:
-        resolveVoxelSeed(binary, o.seedVoxel, x);
-        break;
-      case SeedMode::Point: {
-        x.seedPoint = o.seedPoint;
-        const auto index = io::toIndex(geometry, o.seedPoint);
-        Voxel v;
-        for (int a = 0; a < 3; ++a) {
-          const double r = std::round(index[a]);
-          v[a] = int(std::clamp(r, -1e9, 1e9));
-        }
-        resolveVoxelSeed(binary, v, x);
-        break;
-      }
-      case SeedMode::Surfel: {
-        const Surfel s{o.seedVoxel, o.seedDirection};
-        if (!binary.dims().contains(s.inside())) {
-          std::ostringstream msg;
-          msg << "seed " << s << " lies outside the image domain " << domainText(binary.dims());
-          throw std::runtime_error(msg.str());
-        }
-        try {
-          requireTrackableSeed(binary, s);  // "surfel[...] is not a boundary surfel: ..."
-        } catch (const std::invalid_argument& e) {
-          throw std::runtime_error(std::string("seed ") + e.what());
-        }
-        x.seedSurfel = s;
-        break;
-      }
-      case SeedMode::All:
-        break;
-    }
-    clock.lap(x.timings, "seed");
-
-    progress.stage(stage++, stageCount, "tracking");
-    const SurfaceGraph graph = trackComponent(binary, *x.seedSurfel, o.pair, [&](std::size_t n) {
-      progress.count(n, "surfels");
-    });
-    if (o.seedMode == SeedMode::Largest && graph.surfelCount() != x.surfels) {
-      std::ostringstream msg;
-      msg << "internal error: tracking from " << *x.seedSurfel << " found " << graph.surfelCount()
-          << " surfels, the scan " << x.surfels;
-      throw std::logic_error(msg.str());
-    }
-    clock.lap(x.timings, "track");
-    progress.stage(stage++, stageCount, "converting to triangles");
-    triangles = extractLoops(graph);  // from the bricks the tracker read: the same image
-  }
-  x.surfels = triangles.surfels.size();
-
-  // Vertices: the boundary mapping, then the image geometry; then the OpenMesh mesh.
-  std::vector<std::array<double, 3>> positions;
-  if (x.mapping == "linear")
-    positions = mapVertices(triangles, IsoValueMapping<T>(gray, x.value), geometry);
-  else
-    positions = mapVertices(triangles, MidpointMapping{}, geometry);
-  clock.lap(x.timings, o.seedMode == SeedMode::All ? "place" : "convert");
-  x.mesh = toSurfaceMesh(triangles, positions);
-  triangles = {};
-  x.stats = computeMeshStats(x.mesh);
-  clock.lap(x.timings, "mesh");
-}
-
-template <class T>
-void extractTyped(const DenseImage<T>& gray, const SurfaceOptions& o, Extraction& x, StageClock& clock,
-                  Progress& progress, int stage, int stageCount) {
-  if (x.byLabel) {
-    const LabelImage<T> binary(gray, labelValue<T>(x.value, x.input));
-    run(gray, binary, o, x, clock, progress, stage, stageCount);
-  } else {
-    const ThresholdImage<T> binary(gray, x.value);
-    run(gray, binary, o, x, clock, progress, stage, stageCount);
-  }
+std::string stageText(const std::string& stage) {
+  if (stage == "seed") return "finding the seed";
+  if (stage == "track") return "tracking";
+  if (stage == "convert") return "converting to triangles";
+  if (stage == "scan") return "scanning every boundary";
+  if (stage == "place") return "placing the vertices";
+  return "measuring the components";
 }
 
 }  // namespace
@@ -204,6 +64,8 @@ io::AnyVolume readInput(const InputOptions& input) {
   if (input.origin) g.origin = *input.origin;
   return volume;
 }
+
+int extractionStages(const SurfaceOptions& o) { return o.seedMode == SeedMode::All ? 5 : 7; }
 
 void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extraction& x,
                     StageClock& clock, Progress& progress, int stage, int stageCount) {
@@ -254,13 +116,41 @@ void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extrac
                                range + " of '" + x.input + "': no voxel is above it");
     x.insideVoxels = countAbove(volume, x.value);
   }
-  x.mapping = o.mapping == MappingMode::Midpoint ? "midpoint"
-              : o.mapping == MappingMode::Linear ? "linear"
-              : x.byLabel                        ? "midpoint"
-                                                 : "linear";
   clock.lap(x.timings, "values");
-  std::visit([&](const auto& gray) { extractTyped(gray, o, x, clock, progress, stage + 1, stageCount); },
-             volume);
+
+  ExtractOptions eo;
+  eo.selection = x.byLabel ? Selection::label(x.value) : Selection::threshold(x.value);
+  eo.seed = seedRuleOf(o);
+  eo.pair = o.pair;
+  eo.mapping = o.mapping == MappingMode::Midpoint ? Mapping::Midpoint
+               : o.mapping == MappingMode::Linear ? Mapping::Linear
+                                                  : Mapping::Default;
+  eo.progress = [&](const ProgressEvent& e) {
+    if (e.surfels) progress.count(e.surfels, "surfels");
+    else progress.stage(stage + 1 + e.index, stageCount, stageText(e.stage));
+  };
+  if (o.seedMode == SeedMode::Point) x.seedPoint = o.seedPoint;
+  Surface surface = extract(viewOf(volume), eo);
+  for (const StageTime& t : surface.timings) x.timings.push_back({t.stage, t.seconds});
+  clock.skip();  // the core timed its own stages
+  x.mapping = toString(surface.mapping);
+  x.seedSurfel = surface.seed.surfel;
+  x.seedVoxel = surface.seed.voxel;
+  x.seedVoxelInside = surface.seed.voxelInside;
+  x.walkDirection = surface.seed.walkDirection;
+  x.walkSteps = surface.seed.walkSteps;
+  x.boundaries = surface.boundariesInImage;
+  x.surfels = surface.surfels.size();
+
+  progress.stage(stage + extractionStages(o) - 1, stageCount, "building the mesh");
+  TriangleMesh triangles{std::move(surface.surfels), std::move(surface.triangles)};
+  x.mesh = toSurfaceMesh(triangles, surface.vertices);
+  x.stats = computeMeshStats(x.mesh);
+  for (std::size_t c = 0; c < x.stats.components.size() && c < surface.components.size(); ++c) {
+    x.stats.components[c].area = surface.components[c].area;
+    x.stats.components[c].volume = surface.components[c].volume;
+  }
+  clock.lap(x.timings, "mesh");
 }
 
 }  // namespace surftrack::cli

@@ -33,6 +33,8 @@ class StageClock {
     out.push_back({name, std::chrono::duration<double>(now - last_).count()});
     last_ = now;
   }
+  /// Starts the next stage now, without recording the time since the last lap.
+  void skip() { last_ = std::chrono::steady_clock::now(); }
   double total() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
@@ -82,8 +84,12 @@ struct Extraction {
   std::uintmax_t bytes = 0;
 };
 
+/// The progress stages extractSurface reports: values, the core's stages, mesh.
+int extractionStages(const SurfaceOptions& options);
+
 /// Runs the pipeline on `volume` (already read; `extraction` holds the input fields and the
-/// "read" timing) up to the mesh and its statistics. Throws std::runtime_error with a one-line
+/// "read" timing) up to the mesh and its statistics, through the front door (Extract.h);
+/// reports progress stages stage .. stage + extractionStages(options) - 1 of stageCount. Throws std::runtime_error with a one-line
 /// message for an iso-value outside the data range, a label absent from the image, a seed
 /// outside the domain or on no boundary, an empty selection.
 void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& options,

@@ -18,7 +18,7 @@ int runMesh(const std::vector<std::string>& args) {
 
   Progress progress(Progress::wanted(o.out.quiet));
   StageClock clock;
-  const int stages = o.surface.seedMode == SeedMode::All ? 5 : 6;
+  const int stages = extractionStages(o.surface) + 2;  // + read, write
   progress.stage(0, stages, "reading " + o.input.path);
   const io::AnyVolume volume = readInput(o.input);
   clock.lap(x.timings, "read");

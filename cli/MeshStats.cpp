@@ -1,9 +1,10 @@
 #include "MeshStats.h"
 
+#include "MeshComponents.h"
+
 #include <algorithm>
 #include <cstdint>
 #include <limits>
-#include <numeric>
 
 namespace surftrack::cli {
 
@@ -14,31 +15,21 @@ MeshStats computeMeshStats(const SurfaceMesh& mesh) {
   s.triangles = mesh.n_faces();
   s.euler = (long long)s.vertices - (long long)s.edges + (long long)s.triangles;
 
-  // Components: union-find over the edges.
-  std::vector<std::uint32_t> parent(s.vertices);
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  // Components through the triangles (every vertex of these meshes is on a triangle).
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  triangles.reserve(s.triangles);
+  for (auto fh : mesh.faces()) {
+    auto fv = mesh.cfv_iter(fh);
+    const std::uint32_t a = fv->idx(), b = (++fv)->idx(), c = (++fv)->idx();
+    triangles.push_back({a, b, c});
+  }
+  std::size_t count = 0;
+  const std::vector<std::uint32_t> label = triangleComponents(s.vertices, triangles, count);
+  std::vector<ComponentStats> comps(count);
+  for (std::uint32_t c : label) comps[c].vertices++;
   s.closed = true;
-  for (auto eh : mesh.edges()) {
-    const auto h = mesh.halfedge_handle(eh, 0);
-    const std::uint32_t a = find(mesh.from_vertex_handle(h).idx()), b = find(mesh.to_vertex_handle(h).idx());
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  for (auto eh : mesh.edges())
     if (mesh.is_boundary(eh)) s.closed = false;
-  }
-  std::vector<std::uint32_t> label(s.vertices, ~0u);
-  std::vector<ComponentStats> comps;
-  for (std::uint32_t v = 0; v < s.vertices; ++v) {
-    const std::uint32_t r = find(v);
-    if (label[r] == ~0u) {
-      label[r] = std::uint32_t(comps.size());
-      comps.emplace_back();
-    }
-    label[v] = label[r];
-    comps[label[v]].vertices++;
-  }
   for (auto eh : mesh.edges()) comps[label[mesh.from_vertex_handle(mesh.halfedge_handle(eh, 0)).idx()]].edges++;
   for (auto fh : mesh.faces()) comps[label[mesh.to_vertex_handle(mesh.halfedge_handle(fh)).idx()]].triangles++;
   for (auto& c : comps) c.euler = (long long)c.vertices - (long long)c.edges + (long long)c.triangles;

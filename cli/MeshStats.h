@@ -13,6 +13,7 @@ namespace surftrack::cli {
 struct ComponentStats {
   std::size_t vertices = 0, edges = 0, triangles = 0;
   long long euler = 0;
+  double area = 0, volume = 0;  ///< physical; the volume enclosed (negative: a cavity)
   /// (2 - chi) / 2: an integer for a closed orientable surface.
   double genus() const { return (2.0 - double(euler)) / 2.0; }
 };

@@ -249,6 +249,8 @@ void writeJson(JsonWriter& j, const Extraction& x) {
     j.key("triangles").value(c.triangles);
     j.key("euler_characteristic").value(c.euler);
     j.key("genus").value(c.genus());
+    j.key("area").value(c.area);
+    j.key("enclosed_volume").value(c.volume);
     j.endObject();
   }
   j.endArray();

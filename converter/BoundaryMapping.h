@@ -41,8 +41,8 @@ class IsoValueMapping {
  public:
   static constexpr double kDefaultEpsilon = 1e-3;
 
-  IsoValueMapping(const DenseImage<T>& gray, double isoValue, double epsilon = kDefaultEpsilon)
-      : gray_(&gray), iso_(isoValue), epsilon_(epsilon) {
+  IsoValueMapping(VolumeRef<T> gray, double isoValue, double epsilon = kDefaultEpsilon)
+      : gray_(gray), iso_(isoValue), epsilon_(epsilon) {
     if (!(epsilon > 0.0 && epsilon < 0.5))
       throw std::invalid_argument("IsoValueMapping: epsilon must lie in ]0, 0.5[");
     if (std::isnan(isoValue)) throw std::invalid_argument("IsoValueMapping: iso-value is NaN");
@@ -54,9 +54,9 @@ class IsoValueMapping {
   /// The interpolation parameter t in [epsilon, 1 - epsilon] of surfel s.
   double parameter(const Surfel& s) const {
     const Voxel c = s.inside(), d = s.outside();
-    const Dims& dims = gray_->dims();
+    const Dims& dims = gray_.dims;
     if (!dims.contains(c) || !dims.contains(d)) return 0.5;
-    const double fc = double(gray_->at(c)), fd = double(gray_->at(d));
+    const double fc = double(gray_.at(c)), fd = double(gray_.at(d));
     const double t = (iso_ - fc) / (fd - fc);
     if (!std::isfinite(t)) return 0.5;
     return std::clamp(t, epsilon_, 1.0 - epsilon_);
@@ -68,7 +68,7 @@ class IsoValueMapping {
   double epsilon() const { return epsilon_; }
 
  private:
-  const DenseImage<T>* gray_;
+  VolumeRef<T> gray_;
   double iso_;
   double epsilon_;
 };

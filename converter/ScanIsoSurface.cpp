@@ -13,6 +13,8 @@
 // them (z-edges); each cut edge gets its vertex index before the first cube around it is visited.
 #include "ScanIsoSurface.h"
 
+#include "MeshComponents.h"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -239,57 +241,21 @@ TriangleMesh scanRows(const Dims& dims, AdjacencyPair pair, const RowSource& row
 
 }  // namespace scan
 
-namespace {
-
-/// Union-find over the vertices, joined through every triangle; returns the root of each vertex.
-class VertexUnion {
- public:
-  explicit VertexUnion(const TriangleMesh& mesh) : parent_(mesh.surfels.size()) {
-    std::iota(parent_.begin(), parent_.end(), 0u);
-    for (const auto& t : mesh.triangles) {
-      unite(t[0], t[1]);
-      unite(t[0], t[2]);
-    }
-  }
-  std::uint32_t find(std::uint32_t v) {
-    while (parent_[v] != v) v = parent_[v] = parent_[parent_[v]];
-    return v;
-  }
-
- private:
-  void unite(std::uint32_t a, std::uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);  // root = smallest vertex
-  }
-  std::vector<std::uint32_t> parent_;
-};
-
-}  // namespace
-
 std::vector<std::uint32_t> meshComponents(const TriangleMesh& mesh, std::size_t& count) {
-  VertexUnion sets(mesh);
-  const std::size_t n = mesh.surfels.size();
-  std::vector<std::uint32_t> label(n);
-  count = 0;
-  // Roots are the smallest vertices of their sets, so a root is labelled before its members.
-  for (std::size_t v = 0; v < n; ++v) {
-    const std::uint32_t r = sets.find(std::uint32_t(v));
-    label[v] = r == v ? std::uint32_t(count++) : label[r];
-  }
-  return label;
+  return triangleComponents(mesh.surfels.size(), mesh.triangles, count);
 }
 
 TriangleMesh extractComponent(const TriangleMesh& mesh, const Surfel& seed) {
   const auto it = std::find(mesh.surfels.begin(), mesh.surfels.end(), seed);
   if (it == mesh.surfels.end())
     throw std::invalid_argument("extractComponent: the seed is not a vertex of the mesh");
-  VertexUnion sets(mesh);
-  const std::uint32_t root = sets.find(std::uint32_t(it - mesh.surfels.begin()));
+  std::size_t count = 0;
+  const std::vector<std::uint32_t> label = meshComponents(mesh, count);
+  const std::uint32_t root = label[std::size_t(it - mesh.surfels.begin())];
   TriangleMesh out;
   std::vector<std::uint32_t> renumber(mesh.surfels.size(), ~0u);
   for (std::size_t v = 0; v < mesh.surfels.size(); ++v)
-    if (sets.find(std::uint32_t(v)) == root) {
+    if (label[v] == root) {
       renumber[v] = std::uint32_t(out.surfels.size());
       out.surfels.push_back(mesh.surfels[v]);
     }

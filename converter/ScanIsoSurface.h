@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <limits>
 #include <type_traits>
@@ -71,11 +72,18 @@ class GenericRows final : public RowSource {
   int nx_;
 };
 
-/// Rows of a ThresholdImage<T> (f > s), binarised 64 voxels at a time by ThresholdImage::row.
-template <class T>
-class ThresholdRows final : public RowSource {
+/// A binary image that reads up to 64 voxels of a row in one call: row(x0, y, z, count) gives
+/// voxels (x0 + i, y, z) as bits i (ThresholdImage, LabelImage, the front door's sources).
+template <class Image>
+concept RowReadable = requires(const Image& image) {
+  { image.row(0, 0, 0, 64) } -> std::convertible_to<std::uint64_t>;
+};
+
+/// Rows of a RowReadable image, binarised 64 voxels at a time by its row().
+template <RowReadable Image>
+class WordRows final : public RowSource {
  public:
-  explicit ThresholdRows(const ThresholdImage<T>& image)
+  explicit WordRows(const Image& image)
       : image_(image), dims_(image.dims()), outside_(image(-1, -1, -1)) {}
 
   void fillRow(int y, int z, std::uint64_t* row) const override {
@@ -100,15 +108,10 @@ class ThresholdRows final : public RowSource {
     row[(x + kRowOffset) >> 6] |= std::uint64_t(1) << ((x + kRowOffset) & 63);
   }
 
-  const ThresholdImage<T>& image_;
+  const Image& image_;
   Dims dims_;
   bool outside_;
 };
-
-template <class Image>
-struct IsThresholdImage : std::false_type {};
-template <class T>
-struct IsThresholdImage<ThresholdImage<T>> : std::true_type {};
 
 }  // namespace scan
 
@@ -120,12 +123,13 @@ TriangleMesh scanIsoSurfaceGeneric(const BinaryImage& image, AdjacencyPair pair)
 
 /// The kappa-lambda-iso-surface of a whole binary image (paper §5.1): the triangles of the
 /// configuration table of `pair` in every digital 3-cube meeting the domain, oriented from the
-/// 1-voxels to the 0-voxels, one vertex per boundary surfel. Uses the fast row binariser for a
-/// ThresholdImage (and so for binaryView), the generic path otherwise; both give the same mesh.
+/// 1-voxels to the 0-voxels, one vertex per boundary surfel. Reads whole rows of a RowReadable
+/// image (ThresholdImage, and so binaryView; LabelImage), voxel by voxel otherwise; both give
+/// the same mesh.
 template <class BinaryImage>
 TriangleMesh scanIsoSurface(const BinaryImage& image, AdjacencyPair pair) {
-  if constexpr (scan::IsThresholdImage<BinaryImage>::value)
-    return scan::scanRows(image.dims(), pair, scan::ThresholdRows(image));
+  if constexpr (scan::RowReadable<BinaryImage>)
+    return scan::scanRows(image.dims(), pair, scan::WordRows<BinaryImage>(image));
   else
     return scanIsoSurfaceGeneric(image, pair);
 }

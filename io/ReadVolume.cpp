@@ -79,9 +79,13 @@ std::optional<ScalarType> scalarTypeOf(itk::IOComponentEnum c) {
   using C = itk::IOComponentEnum;
   switch (c) {
     case C::UCHAR: return ScalarType::UInt8;
+    case C::CHAR: return ScalarType::Int8;
     case C::SHORT: return ScalarType::Int16;
     case C::USHORT: return ScalarType::UInt16;
     case C::INT: return ScalarType::Int32;
+    case C::UINT: return ScalarType::UInt32;
+    case C::LONG: case C::LONGLONG: return ScalarType::Int64;
+    case C::ULONG: case C::ULONGLONG: return ScalarType::UInt64;
     case C::FLOAT: return ScalarType::Float32;
     case C::DOUBLE: return ScalarType::Float64;
     default: return std::nullopt;
@@ -151,15 +155,7 @@ AnyVolume readDicomDirectory(const std::string& path) {
                                               " components per voxel"));
   const auto type = scalarTypeOf(dicom->GetComponentType());
   if (!type) throw ReadError(unsupportedType(path, "'" + componentName(dicom->GetComponentType()) + "'"));
-  switch (*type) {
-    case ScalarType::UInt8: return readSeriesAs<std::uint8_t>(files, path);
-    case ScalarType::Int16: return readSeriesAs<std::int16_t>(files, path);
-    case ScalarType::UInt16: return readSeriesAs<std::uint16_t>(files, path);
-    case ScalarType::Int32: return readSeriesAs<std::int32_t>(files, path);
-    case ScalarType::Float32: return readSeriesAs<float>(files, path);
-    case ScalarType::Float64: return readSeriesAs<double>(files, path);
-  }
-  throw ReadError("unreachable");
+  return visitScalarType(*type, [&](auto v) { return readSeriesAs<decltype(v)>(files, path); });
 }
 
 std::string lowerName(const std::string& path) {
@@ -329,15 +325,7 @@ AnyVolume readVolume(const std::string& path) {
     if (!type)
       throw ReadError(unsupportedType(path, "'" + componentName(imageIO->GetComponentType()) + "'"));
     requireCompleteData(imageIO, path, voxels);
-    switch (*type) {
-      case ScalarType::UInt8: return readFileAs<std::uint8_t>(imageIO, path);
-      case ScalarType::Int16: return readFileAs<std::int16_t>(imageIO, path);
-      case ScalarType::UInt16: return readFileAs<std::uint16_t>(imageIO, path);
-      case ScalarType::Int32: return readFileAs<std::int32_t>(imageIO, path);
-      case ScalarType::Float32: return readFileAs<float>(imageIO, path);
-      case ScalarType::Float64: return readFileAs<double>(imageIO, path);
-    }
-    throw ReadError("unreachable");
+    return visitScalarType(*type, [&](auto v) { return readFileAs<decltype(v)>(imageIO, path); });
   } catch (const itk::ExceptionObject& e) {
     throw ReadError("cannot read '" + path + "': " + oneLine(e));
   } catch (const std::bad_alloc&) {

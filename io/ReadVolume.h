@@ -13,24 +13,20 @@
 #include <variant>
 
 #include "Image.h"
+#include "ScalarType.h"
 
 namespace surftrack::io {
 
-/// The six voxel types the tool accepts.
-enum class ScalarType { UInt8, Int16, UInt16, Int32, Float32, Float64 };
+using surftrack::ScalarType;
+using surftrack::parseScalarType;
+using surftrack::sizeOf;
+using surftrack::toString;
 
-/// "uint8", "int16", "uint16", "int32", "float", "double".
-std::string toString(ScalarType type);
-
-/// Parses the names above, plus the aliases "float32", "float64", "u8", "i16", "u16", "i32";
-/// throws std::invalid_argument otherwise.
-ScalarType parseScalarType(std::string_view text);
-
-std::size_t sizeOf(ScalarType type);
-
-/// A volume of one of the six types.
-using AnyVolume = std::variant<DenseImage<std::uint8_t>, DenseImage<std::int16_t>,
-                               DenseImage<std::uint16_t>, DenseImage<std::int32_t>,
+/// A volume of one of the ten scalar types.
+using AnyVolume = std::variant<DenseImage<std::uint8_t>, DenseImage<std::int8_t>,
+                               DenseImage<std::uint16_t>, DenseImage<std::int16_t>,
+                               DenseImage<std::uint32_t>, DenseImage<std::int32_t>,
+                               DenseImage<std::uint64_t>, DenseImage<std::int64_t>,
                                DenseImage<float>, DenseImage<double>>;
 
 ScalarType scalarTypeOf(const AnyVolume& volume);
@@ -70,9 +66,5 @@ void writeVolume(const AnyVolume& volume, const std::string& path);
 /// Writes a uint8 or uint16 volume as a DICOM series, one file per slice z in `directory`
 /// (which must exist), with each slice's position, the orientation and the spacing (tests).
 void writeDicomSeries(const AnyVolume& volume, const std::string& directory);
-
-/// The inverse of ImageGeometry::toPhysical: the continuous index of a physical point.
-/// Throws std::invalid_argument if the direction matrix is singular.
-std::array<double, 3> toIndex(const ImageGeometry& geometry, const std::array<double, 3>& point);
 
 }  // namespace surftrack::io

@@ -14,6 +14,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "Geometry.h"
 #include "HugePages.h"
 #include "Voxel.h"
 
@@ -22,34 +23,6 @@
 #endif
 
 namespace surftrack {
-
-/// Size of a domain [0, nx) x [0, ny) x [0, nz).
-struct Dims {
-  int nx = 0, ny = 0, nz = 0;
-  constexpr int operator[](int axis) const { return axis == 0 ? nx : axis == 1 ? ny : nz; }
-  constexpr bool contains(int x, int y, int z) const {
-    return unsigned(x) < unsigned(nx) && unsigned(y) < unsigned(ny) && unsigned(z) < unsigned(nz);
-  }
-  constexpr bool contains(Voxel v) const { return contains(v.x, v.y, v.z); }
-  constexpr std::size_t count() const { return std::size_t(nx) * std::size_t(ny) * std::size_t(nz); }
-  constexpr bool empty() const { return nx <= 0 || ny <= 0 || nz <= 0; }
-  friend constexpr bool operator==(const Dims&, const Dims&) = default;
-};
-
-/// Physical placement of voxel indices: x_phys = origin + direction * (spacing ⊙ index).
-struct ImageGeometry {
-  std::array<double, 3> spacing{1.0, 1.0, 1.0};
-  std::array<double, 3> origin{0.0, 0.0, 0.0};
-  std::array<std::array<double, 3>, 3> direction{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-
-  /// Maps a (continuous) index-space point to physical space.
-  std::array<double, 3> toPhysical(const std::array<double, 3>& index) const {
-    std::array<double, 3> p = origin;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) p[r] += direction[r][c] * spacing[c] * index[c];
-    return p;
-  }
-};
 
 /// A dense volume of scalars (uint8, int16, uint16, int32, float, double, ...), x fastest.
 template <class T>
@@ -87,12 +60,42 @@ class DenseImage {
   std::vector<T> data_;
 };
 
+/// A read-only, non-owning view of a scalar volume held by someone else (a DenseImage, a numpy
+/// array, an ITK buffer, a memory-mapped file): voxel (x, y, z) is data[x sx + y sy + z sz],
+/// strides in elements. Nothing is copied; the owner keeps the memory alive.
+template <class T>
+struct VolumeRef {
+  using value_type = T;
+
+  const T* data = nullptr;
+  Dims dims;
+  std::ptrdiff_t sx = 1, sy = 0, sz = 0;
+
+  VolumeRef() = default;
+  VolumeRef(const T* data, Dims dims, std::ptrdiff_t sx, std::ptrdiff_t sy, std::ptrdiff_t sz)
+      : data(data), dims(dims), sx(sx), sy(sy), sz(sz) {}
+  /// The view of a whole DenseImage (x fastest).
+  VolumeRef(const DenseImage<T>& image)  // NOLINT: a DenseImage is a view of itself
+      : VolumeRef(image.data().data(), image.dims(), 1, image.dims().nx,
+                  std::ptrdiff_t(image.dims().nx) * image.dims().ny) {}
+
+  std::ptrdiff_t offset(int x, int y, int z) const { return x * sx + y * sy + z * sz; }
+  const T& at(int x, int y, int z) const { return data[offset(x, y, z)]; }
+  const T& at(Voxel v) const { return at(v.x, v.y, v.z); }
+  /// Rows of x are contiguous and y, z go forwards: whole rows can be read with vector loads.
+  bool rowsContiguous() const { return sx == 1 && sy >= 0 && sz >= 0; }
+  /// With rowsContiguous(): the elements from data on that belong to the view.
+  std::size_t extent() const {
+    return std::size_t(offset(dims.nx - 1, dims.ny - 1, dims.nz - 1)) + 1;
+  }
+};
+
 /// Binary image of a gray image J at iso-value s (§3.1): f(v) > s is a 1-voxel.
 template <class T>
 class ThresholdImage {
  public:
-  ThresholdImage(const DenseImage<T>& image, double isoValue, bool outside = false)
-      : image_(&image), iso_(isoValue), outside_(outside) {
+  ThresholdImage(VolumeRef<T> image, double isoValue, bool outside = false)
+      : image_(image), iso_(isoValue), outside_(outside) {
     if (std::isnan(isoValue)) throw std::invalid_argument("iso-value is NaN");
     if constexpr (std::is_integral_v<T> && sizeof(T) <= 4) {
       // For an integer f, f > s <=> f > floor(s); s below (above) the range: all 1 (all 0).
@@ -103,12 +106,12 @@ class ThresholdImage {
     }
   }
   bool operator()(int x, int y, int z) const {
-    if (!image_->dims().contains(x, y, z)) return outside_;
-    return double(image_->at(x, y, z)) > iso_;
+    if (!image_.dims.contains(x, y, z)) return outside_;
+    return double(image_.at(x, y, z)) > iso_;
   }
   bool operator()(Voxel v) const { return (*this)(v.x, v.y, v.z); }
-  const Dims& dims() const { return image_->dims(); }
-  const DenseImage<T>& gray() const { return *image_; }
+  const Dims& dims() const { return image_.dims; }
+  const VolumeRef<T>& gray() const { return image_; }
   double isoValue() const { return iso_; }
 
   /// row(x0, y0 + j, z0 + k, width) into out[k * ny + j] for a block of nz x ny rows, width <= 16:
@@ -117,17 +120,16 @@ class ThresholdImage {
   void rows(int x0, int y0, int z0, int width, int ny, int nz, std::uint16_t* out) const {
 #if defined(__SSE2__)
     if constexpr (std::is_same_v<T, std::uint8_t>) {
-      const Dims& d = image_->dims();
+      const Dims& d = image_.dims;
       // Loads of 16 may run into the next row (masked off), never past the data.
-      if (mode_ == Mode::Compare && x0 >= 0 && y0 >= 0 && z0 >= 0 && x0 + width <= d.nx &&
-          y0 + ny <= d.ny && z0 + nz <= d.nz &&
-          image_->index(x0, y0 + ny - 1, z0 + nz - 1) + 16 <= image_->data().size()) {
+      if (mode_ == Mode::Compare && image_.rowsContiguous() && x0 >= 0 && y0 >= 0 && z0 >= 0 &&
+          x0 + width <= d.nx && y0 + ny <= d.ny && z0 + nz <= d.nz &&
+          std::size_t(image_.offset(x0, y0 + ny - 1, z0 + nz - 1)) + 16 <= image_.extent()) {
         const unsigned keep = (1u << width) - 1;
-        const std::size_t sliceStep = std::size_t(d.nx) * std::size_t(d.ny);
-        const T* slice = &image_->at(x0, y0, z0);
-        for (int k = 0; k < nz; ++k, slice += sliceStep) {
+        const T* slice = &image_.at(x0, y0, z0);
+        for (int k = 0; k < nz; ++k, slice += image_.sz) {
           const T* row = slice;
-          for (int j = 0; j < ny; ++j, row += d.nx) *out++ = std::uint16_t(compare16(row) & keep);
+          for (int j = 0; j < ny; ++j, row += image_.sy) *out++ = std::uint16_t(compare16(row) & keep);
         }
         return;
       }
@@ -140,13 +142,18 @@ class ThresholdImage {
   /// Values of the `count` <= 64 voxels (x0 + i, y, z) as bits i: the fast path of the
   /// scanner and of the tracker's brick cache, which binarise whole rows.
   std::uint64_t row(int x0, int y, int z, int count) const {
-    const Dims& d = image_->dims();
+    const Dims& d = image_.dims;
     const std::uint64_t all = lowBits(count);
     if (y < 0 || z < 0 || y >= d.ny || z >= d.nz || x0 >= d.nx || x0 + count <= 0)
       return outside_ ? all : 0;
     const int lo = x0 < 0 ? -x0 : 0, hi = x0 + count > d.nx ? d.nx - x0 : count;
     const std::uint64_t bits = outside_ ? all & ~(lowBits(hi - lo) << lo) : 0;
-    return bits | (compare(&image_->at(x0 + lo, y, z), hi - lo) << lo);
+    if (image_.sx != 1) [[unlikely]] {
+      std::uint64_t strided = 0;
+      for (int i = lo; i < hi; ++i) strided |= std::uint64_t(double(image_.at(x0 + i, y, z)) > iso_) << i;
+      return bits | strided;
+    }
+    return bits | (compare(&image_.at(x0 + lo, y, z), hi - lo) << lo);
   }
 
  private:
@@ -183,7 +190,7 @@ class ThresholdImage {
     return bits;
   }
 
-  const DenseImage<T>* image_;
+  VolumeRef<T> image_;
   double iso_;
   bool outside_;
   Mode mode_ = Mode::Compare;
@@ -194,17 +201,30 @@ class ThresholdImage {
 template <class T>
 class LabelImage {
  public:
-  LabelImage(const DenseImage<T>& image, T label, bool outside = false)
-      : image_(&image), label_(label), outside_(outside) {}
+  LabelImage(VolumeRef<T> image, T label, bool outside = false)
+      : image_(image), label_(label), outside_(outside) {}
   bool operator()(int x, int y, int z) const {
-    if (!image_->dims().contains(x, y, z)) return outside_;
-    return image_->at(x, y, z) == label_;
+    if (!image_.dims.contains(x, y, z)) return outside_;
+    return image_.at(x, y, z) == label_;
   }
   bool operator()(Voxel v) const { return (*this)(v.x, v.y, v.z); }
-  const Dims& dims() const { return image_->dims(); }
+  const Dims& dims() const { return image_.dims; }
+
+  /// Values of the `count` <= 64 voxels (x0 + i, y, z) as bits i (ThresholdImage::row's
+  /// contract): the scanner and the front door read label images a row at a time.
+  std::uint64_t row(int x0, int y, int z, int count) const {
+    std::uint64_t bits = 0;
+    const bool inRow = y >= 0 && z >= 0 && y < image_.dims.ny && z < image_.dims.nz;
+    for (int i = 0; i < count; ++i) {
+      const int x = x0 + i;
+      const bool v = inRow && x >= 0 && x < image_.dims.nx ? image_.at(x, y, z) == label_ : outside_;
+      bits |= std::uint64_t(v) << i;
+    }
+    return bits;
+  }
 
  private:
-  const DenseImage<T>* image_;
+  VolumeRef<T> image_;
   T label_;
   bool outside_;
 };

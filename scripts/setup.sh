@@ -10,7 +10,12 @@ packages=(
   libgtest-dev                   # GoogleTest
   libinsighttoolkit5-dev         # ITK: NIfTI / NRRD / MetaImage / DICOM volumes for the CLI
   libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip size checks)
+  libcli11-dev                   # CLI11: the command line
+  nlohmann-json3-dev             # nlohmann-json: the CLI's JSON output
   gnuplot-nox                    # plots of the Figure 9 benchmark
+  python3-dev python3-numpy pybind11-dev   # the Python package (Debian's python3, /usr/bin/python3)
+  python3-pytest python3-skimage python3-nibabel python3-meshio  # its tests and examples
+  python3-venv python3-pip python3-setuptools  # 'pip install --no-build-isolation .' in a venv
   mricron-data                   # real MRI volumes used by the demo and one test
 )
 

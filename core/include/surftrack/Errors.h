@@ -1,0 +1,27 @@
+// The exceptions of the front door (docs/api.md). Every message is one line and names the
+// offending value.
+#pragma once
+
+#include <stdexcept>
+
+namespace surftrack {
+
+/// Bad input: a volume, selection, seed or option the caller can correct.
+class InvalidInput : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// A broken invariant inside the engine: a bug, to be reported.
+class InternalError : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
+};
+
+/// The caller's cancellation flag was raised during an extraction.
+class Cancelled : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace surftrack

@@ -1,0 +1,270 @@
+// The front door's pipeline (docs/api.md): seed rule -> trackComponent -> extractLoops ->
+// boundary mapping -> physical coordinates -> per-component figures; or the scanning method
+// for `largest` and `all`.
+#include "Extract.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "BoundaryMapping.h"
+#include "FindSeed.h"
+#include "LoopExtraction.h"
+#include "ScanIsoSurface.h"
+#include "SelectionValue.h"
+#include "SourceImage.h"
+#include "TrackComponent.h"
+
+namespace surftrack {
+
+std::string toString(Mapping mapping) {
+  switch (mapping) {
+    case Mapping::Midpoint: return "midpoint";
+    case Mapping::Linear: return "linear";
+    case Mapping::Default: break;
+  }
+  return "default";
+}
+
+Mapping parseMapping(const std::string& text) {
+  for (Mapping m : {Mapping::Default, Mapping::Midpoint, Mapping::Linear})
+    if (text == toString(m)) return m;
+  throw InvalidInput("unknown mapping '" + text + "': expected midpoint, linear or default");
+}
+
+namespace {
+
+std::string numberText(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+std::string domainText(const Dims& d) {
+  std::ostringstream s;
+  s << "[0," << d.nx << ")x[0," << d.ny << ")x[0," << d.nz << ")";
+  return s.str();
+}
+
+/// Stage events, timings and the cancellation check, one stage after the other.
+class Stages {
+ public:
+  Stages(const ExtractOptions& options, int count, Surface& out)
+      : options_(options), count_(count), out_(out), last_(std::chrono::steady_clock::now()) {}
+
+  void begin(const std::string& name) {
+    end();
+    checkCancel();
+    current_ = name;
+    if (options_.progress) options_.progress(ProgressEvent{name, index_, count_, 0});
+    ++index_;
+  }
+  void end() {
+    const auto now = std::chrono::steady_clock::now();
+    if (!current_.empty())
+      out_.timings.push_back({current_, std::chrono::duration<double>(now - last_).count()});
+    current_.clear();
+    last_ = now;
+  }
+  void surfelsFound(std::size_t n) {
+    checkCancel();
+    if (options_.progress) options_.progress(ProgressEvent{current_, index_ - 1, count_, n});
+  }
+  void checkCancel() const {
+    if (options_.cancel && options_.cancel->load(std::memory_order_relaxed))
+      throw Cancelled("extraction cancelled");
+  }
+
+ private:
+  const ExtractOptions& options_;
+  int count_, index_ = 0;
+  Surface& out_;
+  std::string current_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+[[noreturn]] void throwEmpty(const VoxelSource&, const Selection& selection) {
+  throw InvalidInput("empty selection: no voxel has " +
+                     std::string(selection.isLabel() ? "f = " : "f > ") + numberText(selection.value) +
+                     " with a 0-voxel next to it: the image has no boundary surfel");
+}
+
+/// The seed rule for a voxel: a 1-voxel walks to the first 1->0 step, a 0-voxel to the first
+/// 0->1 step, along +x, then -x, +y, -y, +z, -z (seedAlongRay).
+Surfel resolveVoxelSeed(const SourceImage& binary, Voxel v, const SeedRule& rule, SeedReport& seed) {
+  const Dims& dims = binary.dims();
+  if (!dims.contains(v)) {
+    std::ostringstream msg;
+    msg << "seed voxel " << v << " lies outside the image domain " << domainText(dims);
+    if (rule.kind == SeedRule::Kind::Point)
+      msg << " (the seed point (" << numberText(rule.physical[0]) << "," << numberText(rule.physical[1])
+          << "," << numberText(rule.physical[2]) << ") is outside the image)";
+    throw InvalidInput(msg.str());
+  }
+  seed.voxel = v;
+  seed.voxelInside = binary(v);
+  for (Direction d = 0; d < 6; ++d)
+    if (auto s = seedAlongRay(binary, v, d)) {
+      seed.walkDirection = d;
+      const Voxel delta = s->inside() - v;
+      seed.walkSteps = std::abs(delta.x) + std::abs(delta.y) + std::abs(delta.z);
+      return *s;
+    }
+  std::ostringstream msg;
+  msg << "seed voxel " << v << " is not on any boundary: it is a 0-voxel and no 1-voxel lies on "
+      << "the six axis rays from it";
+  throw InvalidInput(msg.str());
+}
+
+Surfel resolveSurfelSeed(const SourceImage& binary, const Surfel& s) {
+  if (!binary.dims().contains(s.inside())) {
+    std::ostringstream msg;
+    msg << "seed " << s << " lies outside the image domain " << domainText(binary.dims());
+    throw InvalidInput(msg.str());
+  }
+  try {
+    requireTrackableSeed(binary, s);  // "surfel[...] is not a boundary surfel: ..."
+  } catch (const std::invalid_argument& e) {
+    throw InvalidInput(std::string("seed ") + e.what());
+  }
+  return s;
+}
+
+/// Vertex positions in index space by the boundary mapping (paper §3.1); the linear one reads
+/// the gray values of both voxels of each surfel, in one batch, from the source.
+std::vector<std::array<double, 3>> placeVertices(const VoxelSource& source, const TriangleMesh& mesh,
+                                                 Mapping mapping, const Selection& selection,
+                                                 double epsilon) {
+  const std::size_t n = mesh.surfels.size();
+  std::vector<std::array<double, 3>> points(n);
+  if (mapping == Mapping::Midpoint) {
+    for (std::size_t v = 0; v < n; ++v) points[v] = MidpointMapping{}(mesh.surfels[v]);
+    return points;
+  }
+  const Dims dims = source.dims();
+  std::vector<Voxel> voxels;
+  voxels.reserve(2 * n);
+  for (const Surfel& s : mesh.surfels)
+    if (dims.contains(s.inside()) && dims.contains(s.outside())) {
+      voxels.push_back(s.inside());
+      voxels.push_back(s.outside());
+    }
+  std::vector<double> f(voxels.size());
+  source.values(voxels.data(), voxels.size(), f.data());
+  std::size_t next = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const Surfel& s = mesh.surfels[v];
+    double t = 0.5;  // a voxel outside the domain: no gray value to interpolate
+    if (dims.contains(s.inside()) && dims.contains(s.outside())) {
+      const double fc = f[next], fd = f[next + 1];
+      next += 2;
+      const double u = (selection.value - fc) / (fd - fc);
+      if (std::isfinite(u)) t = std::clamp(u, epsilon, 1.0 - epsilon);
+    }
+    points[v] = pointOnSurfel(s, t);
+  }
+  return points;
+}
+
+}  // namespace
+
+Surface extract(const VoxelSource& source, const ExtractOptions& o) {
+  using Kind = SeedRule::Kind;
+  Surface out;
+  out.pair = o.pair;
+  out.selection = o.selection;
+  requireSelectable(source.type(), o.selection);
+  out.mapping = o.mapping != Mapping::Default ? o.mapping
+                : o.selection.isLabel()       ? Mapping::Midpoint
+                                              : Mapping::Linear;
+  if (out.mapping == Mapping::Linear && o.selection.isLabel())
+    throw InvalidInput("the linear mapping interpolates an iso-value: a label selection takes the "
+                       "midpoint mapping");
+  if (!(o.epsilon > 0 && o.epsilon < 0.5))
+    throw InvalidInput("epsilon " + numberText(o.epsilon) + " is outside ]0, 0.5[");
+
+  const bool scanning = o.seed.kind == Kind::All;
+  Stages stages(o, scanning ? 3 : 5, out);
+  const SourceImage binary(source, o.selection);
+  const ImageGeometry geometry = source.geometry();
+  TriangleMesh mesh;
+  if (scanning) {
+    stages.begin("scan");
+    mesh = scanIsoSurface(binary, o.pair);
+    if (mesh.surfels.empty()) throwEmpty(source, o.selection);
+  } else {
+    stages.begin("seed");
+    Surfel seed;
+    std::size_t expected = 0;
+    switch (o.seed.kind) {
+      case Kind::Largest: {
+        const TriangleMesh all = scanIsoSurface(binary, o.pair);
+        std::size_t count = 0;
+        const std::vector<std::uint32_t> component = meshComponents(all, count);
+        if (count == 0) throwEmpty(source, o.selection);
+        std::vector<std::size_t> size(count, 0);
+        for (std::uint32_t c : component) ++size[c];
+        const std::size_t best = std::size_t(std::max_element(size.begin(), size.end()) - size.begin());
+        seed = all.surfels[std::size_t(std::find(component.begin(), component.end(), best) - component.begin())];
+        out.boundariesInImage = count;
+        expected = size[best];
+        break;
+      }
+      case Kind::Voxel: seed = resolveVoxelSeed(binary, o.seed.voxel, o.seed, out.seed); break;
+      case Kind::Point: {
+        std::array<double, 3> index;
+        try {
+          index = geometry.toIndex(o.seed.physical);
+        } catch (const std::invalid_argument& e) {
+          throw InvalidInput(e.what());
+        }
+        Voxel v;
+        for (int a = 0; a < 3; ++a) v[a] = int(std::clamp(std::round(index[a]), -1e9, 1e9));
+        seed = resolveVoxelSeed(binary, v, o.seed, out.seed);
+        break;
+      }
+      case Kind::Surfel: seed = resolveSurfelSeed(binary, o.seed.surfel); break;
+      case Kind::All: break;
+    }
+    out.seed.surfel = seed;
+
+    stages.begin("track");
+    const SurfaceGraph graph =
+        trackComponent(binary, seed, o.pair, [&](std::size_t n) { stages.surfelsFound(n); });
+    if (expected && graph.surfelCount() != expected) {
+      std::ostringstream msg;
+      msg << "tracking from " << seed << " found " << graph.surfelCount() << " surfels, the scan "
+          << expected;
+      throw InternalError(msg.str());
+    }
+    stages.begin("convert");
+    try {
+      mesh = extractLoops(graph);  // from the bricks the tracker read: the same image
+    } catch (const std::logic_error& e) {
+      throw InternalError(e.what());
+    }
+  }
+
+  stages.begin("place");
+  out.vertices = placeVertices(source, mesh, out.mapping, o.selection, o.epsilon);
+  for (auto& p : out.vertices) p = geometry.toPhysical(p);
+  out.surfels = std::move(mesh.surfels);
+  out.triangles = std::move(mesh.triangles);
+  if (geometry.handedness() < 0)  // a mirrored frame: keep the normals pointing outwards
+    for (auto& t : out.triangles) std::swap(t[1], t[2]);
+
+  stages.begin("figures");
+  out.components = componentFigures(out.vertices, out.triangles);
+  if (scanning) out.boundariesInImage = out.components.size();
+  for (const ComponentFigures& c : out.components) out.euler += c.euler;
+  stages.end();
+  return out;
+}
+
+Surface extract(const VolumeView& view, const ExtractOptions& options) {
+  return extract(*makeViewSource(view), options);
+}
+
+}  // namespace surftrack

@@ -1,0 +1,76 @@
+// Per-component figures and vertex normals of a Surface: plain sums over its triangles.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "Extract.h"
+#include "MeshComponents.h"
+
+namespace surftrack {
+namespace {
+
+using Point = std::array<double, 3>;
+
+Point cross(const Point& a, const Point& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+Point minus(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+}  // namespace
+
+std::vector<ComponentFigures> componentFigures(const std::vector<Point>& vertices,
+                                               const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                                               std::vector<std::uint32_t>* componentOf) {
+  std::size_t count = 0;
+  std::vector<std::uint32_t> label = triangleComponents(vertices.size(), triangles, count);
+  std::vector<ComponentFigures> figures(count);
+  for (std::uint32_t c : label) ++figures[c].surfels;
+  for (const auto& t : triangles) {
+    ComponentFigures& f = figures[label[t[0]]];
+    ++f.triangles;
+    const Point& a = vertices[t[0]];
+    const Point n = cross(minus(vertices[t[1]], a), minus(vertices[t[2]], a));
+    f.area += 0.5 * std::sqrt(dot(n, n));
+    // Divergence theorem: the signed volume of the tetrahedron (0, a, b, c), summed.
+    f.volume += dot(a, cross(vertices[t[1]], vertices[t[2]])) / 6.0;
+  }
+  for (ComponentFigures& f : figures) {
+    f.edges = 3 * f.triangles / 2;  // a closed surface: every edge borders two triangles
+    f.euler = (long long)f.surfels - (long long)f.edges + (long long)f.triangles;
+  }
+  // By decreasing size; the labels follow.
+  std::vector<std::uint32_t> order(count);
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return figures[a].surfels > figures[b].surfels; });
+  std::vector<ComponentFigures> sorted(count);
+  std::vector<std::uint32_t> rankOf(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    sorted[i] = figures[order[i]];
+    rankOf[order[i]] = std::uint32_t(i);
+  }
+  if (componentOf) {
+    for (std::uint32_t& c : label) c = rankOf[c];
+    *componentOf = std::move(label);
+  }
+  return sorted;
+}
+
+std::vector<Point> vertexNormals(const Surface& surface) {
+  std::vector<Point> normals(surface.vertices.size(), Point{0, 0, 0});
+  for (const auto& t : surface.triangles) {
+    const Point& a = surface.vertices[t[0]];
+    const Point n = cross(minus(surface.vertices[t[1]], a), minus(surface.vertices[t[2]], a));
+    for (std::uint32_t v : t)
+      for (int k = 0; k < 3; ++k) normals[v][k] += n[k];  // |n| = 2 area: area-weighted
+  }
+  for (Point& n : normals) {
+    const double length = std::sqrt(dot(n, n));
+    if (length > 0)
+      for (double& x : n) x /= length;
+  }
+  return normals;
+}
+
+}  // namespace surftrack
