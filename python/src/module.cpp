@@ -1,0 +1,209 @@
+// _surftrack: the Python binding of the front door (docs/python.md). It only translates: numpy
+// arrays to VolumeViews (no copy), Python arguments to ExtractOptions, a Surface to numpy
+// arrays. The axis handling and the defaults live in surftrack/__init__.py.
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <surftrack/Extract.h>
+
+namespace py = pybind11;
+using namespace surftrack;
+
+namespace {
+
+/// The ScalarType of a numpy dtype; throws TypeError for anything but the ten types.
+ScalarType scalarTypeOfDtype(const py::dtype& dtype) {
+  const char kind = dtype.kind();
+  const auto size = dtype.itemsize();
+  if (kind == 'u' || kind == 'b') {
+    if (size == 1) return ScalarType::UInt8;
+    if (size == 2) return ScalarType::UInt16;
+    if (size == 4) return ScalarType::UInt32;
+    if (size == 8) return ScalarType::UInt64;
+  } else if (kind == 'i') {
+    if (size == 1) return ScalarType::Int8;
+    if (size == 2) return ScalarType::Int16;
+    if (size == 4) return ScalarType::Int32;
+    if (size == 8) return ScalarType::Int64;
+  } else if (kind == 'f') {
+    if (size == 4) return ScalarType::Float32;
+    if (size == 8) return ScalarType::Float64;
+  }
+  throw py::type_error("unsupported volume dtype '" + py::cast<std::string>(py::str(py::handle(dtype))) +
+                       "': expected bool, uint8/16/32/64, int8/16/32/64, float32 or float64");
+}
+
+template <class T>
+py::array_t<T> toArray(const std::vector<T>& flat, std::vector<py::ssize_t> shape) {
+  py::array_t<T> out(shape);
+  std::copy(flat.begin(), flat.end(), out.mutable_data());
+  return out;
+}
+
+/// Runs extract() on `volume` whose engine axes x, y, z are the array axes order[0..2].
+py::dict extractArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
+                      double value, const std::string& seedKind, std::array<double, 6> seed,
+                      const std::string& adjacency, const std::string& mapping, double epsilon,
+                      std::array<double, 3> spacing, std::array<double, 3> origin,
+                      std::array<std::array<double, 3>, 3> direction, py::object progress) {
+  if (volume.ndim() != 3)
+    throw py::value_error("the volume must be 3-D, not " + std::to_string(volume.ndim()) + "-D");
+  const ScalarType type = scalarTypeOfDtype(volume.dtype());
+  VolumeView view;
+  view.data = volume.data();
+  view.type = type;
+  for (int e = 0; e < 3; ++e) {
+    const int a = order[e];
+    if (volume.shape(a) == 0) throw py::value_error("the volume is empty (a dimension is 0)");
+    if (volume.shape(a) > (1 << 19) - 3) throw py::value_error("a volume dimension exceeds 524285");
+    if (volume.strides(a) % py::ssize_t(sizeOf(type)) != 0)
+      throw py::value_error("the volume's strides are not multiples of its item size");
+    (e == 0 ? view.dims.nx : e == 1 ? view.dims.ny : view.dims.nz) = int(volume.shape(a));
+    view.strides[e] = volume.strides(a) / py::ssize_t(sizeOf(type));
+    view.geometry.spacing[e] = spacing[a];
+    for (int k = 0; k < 3; ++k) view.geometry.direction[k][e] = direction[k][a];
+  }
+  view.geometry.origin = origin;
+
+  ExtractOptions o;
+  o.selection = selectionKind == "label" ? Selection::label(value) : Selection::threshold(value);
+  o.pair = parseAdjacencyPair(adjacency);
+  o.mapping = parseMapping(mapping);
+  o.epsilon = epsilon;
+  auto engineVoxel = [&](int first) {
+    Voxel v;
+    for (int e = 0; e < 3; ++e) v[e] = int(seed[first + order[e]]);
+    return v;
+  };
+  if (seedKind == "voxel") o.seed = SeedRule::fromVoxel(engineVoxel(0));
+  else if (seedKind == "surfel") {
+    const Voxel c = engineVoxel(0), d = engineVoxel(3), n = d - c;
+    if (std::abs(n.x) + std::abs(n.y) + std::abs(n.z) != 1)
+      throw py::value_error("a seed surfel is a pair of 6-adjacent voxels (c, d)");
+    Direction dir = 0;
+    for (Direction k = 0; k < 6; ++k)
+      if (unitVector(k) == n) dir = k;
+    o.seed = SeedRule::fromSurfel(Surfel{c, dir});
+  } else if (seedKind == "point") o.seed = SeedRule::point({seed[0], seed[1], seed[2]});
+  else if (seedKind == "largest") o.seed = SeedRule::largest();
+  else o.seed = SeedRule::all();
+  // Progress and Ctrl-C: the engine runs without the GIL and takes it back only here.
+  o.progress = [&](const ProgressEvent& e) {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (!progress.is_none()) progress(e.stage, e.index, e.stages, e.surfels);
+  };
+
+  Surface s;
+  std::vector<std::array<double, 3>> normals;
+  {
+    py::gil_scoped_release release;
+    s = extract(view, o);
+    normals = vertexNormals(s);
+  }
+
+  const py::ssize_t n = py::ssize_t(s.vertices.size()), m = py::ssize_t(s.triangles.size());
+  py::array_t<double> vertices({n, py::ssize_t(3)}), normalArray({n, py::ssize_t(3)});
+  py::array_t<std::int64_t> faces({m, py::ssize_t(3)});
+  py::array_t<std::int64_t> surfels({n, py::ssize_t(2), py::ssize_t(3)});
+  py::array_t<double> gray({n, py::ssize_t(2)});
+  {
+    auto v = vertices.mutable_unchecked<2>();
+    auto nn = normalArray.mutable_unchecked<2>();
+    auto sf = surfels.mutable_unchecked<3>();
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const Surfel& sv = s.surfels[std::size_t(i)];
+      const Voxel c = sv.inside(), d = sv.outside();
+      for (int k = 0; k < 3; ++k) {
+        v(i, k) = s.vertices[std::size_t(i)][k];
+        nn(i, k) = normals[std::size_t(i)][k];
+      }
+      for (int e = 0; e < 3; ++e) {  // back to array axes
+        sf(i, 0, order[e]) = c[e];
+        sf(i, 1, order[e]) = d[e];
+      }
+    }
+    auto f = faces.mutable_unchecked<2>();
+    for (py::ssize_t t = 0; t < m; ++t)
+      for (int k = 0; k < 3; ++k) f(t, k) = s.triangles[std::size_t(t)][k];
+  }
+  py::list components;
+  for (const ComponentFigures& c : s.components) {
+    py::dict d;
+    d["surfels"] = c.surfels;
+    d["triangles"] = c.triangles;
+    d["edges"] = c.edges;
+    d["euler"] = c.euler;
+    d["genus"] = c.genus();
+    d["area"] = c.area;
+    d["volume"] = c.volume;
+    components.append(d);
+  }
+  py::dict timings;
+  for (const StageTime& t : s.timings) timings[py::str(t.stage)] = t.seconds;
+  py::dict out;
+  out["vertices"] = vertices;
+  out["faces"] = faces;
+  out["normals"] = normalArray;
+  out["surfels"] = surfels;
+  out["components"] = components;
+  out["euler"] = s.euler;
+  out["boundaries_in_image"] = s.boundariesInImage;
+  out["mapping"] = toString(s.mapping);
+  out["timings"] = timings;
+  if (s.seed.surfel) {
+    py::list c, d;
+    std::array<int, 3> ci{}, di{};
+    for (int e = 0; e < 3; ++e) {
+      ci[order[e]] = s.seed.surfel->inside()[e];
+      di[order[e]] = s.seed.surfel->outside()[e];
+    }
+    out["seed_surfel"] = py::make_tuple(py::make_tuple(ci[0], ci[1], ci[2]), py::make_tuple(di[0], di[1], di[2]));
+    out["seed_walk_steps"] = s.seed.walkSteps;
+  }
+  return out;
+}
+
+void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
+                 py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> faces,
+                 py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> surfels,
+                 const std::string& path, bool binary) {
+  if (vertices.ndim() != 2 || vertices.shape(1) != 3) throw py::value_error("vertices must be (N, 3)");
+  if (faces.ndim() != 2 || faces.shape(1) != 3) throw py::value_error("faces must be (M, 3)");
+  Surface s;
+  const std::size_t n = std::size_t(vertices.shape(0));
+  s.vertices.resize(n);
+  s.surfels.resize(n);
+  auto v = vertices.unchecked<2>();
+  auto sf = surfels.unchecked<3>();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) s.vertices[i][k] = v(py::ssize_t(i), k);
+    const Voxel c{int(sf(i, 0, 0)), int(sf(i, 0, 1)), int(sf(i, 0, 2))};
+    const Voxel d{int(sf(i, 1, 0)), int(sf(i, 1, 1)), int(sf(i, 1, 2))};
+    for (Direction k = 0; k < 6; ++k)
+      if (unitVector(k) == d - c) s.surfels[i] = Surfel{c, k};
+  }
+  auto f = faces.unchecked<2>();
+  s.triangles.resize(std::size_t(faces.shape(0)));
+  for (std::size_t t = 0; t < s.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t idx = f(py::ssize_t(t), k);
+      if (idx < 0 || std::size_t(idx) >= n) throw py::value_error("a face refers to a vertex that does not exist");
+      s.triangles[t][k] = std::uint32_t(idx);
+    }
+  py::gil_scoped_release release;
+  writeSurface(s, path, binary);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_surftrack, m) {
+  m.doc() = "surftrack's C++ front door (see surftrack.extract)";
+  py::register_exception<InvalidInput>(m, "InvalidInput", PyExc_ValueError);
+  py::register_exception<InternalError>(m, "InternalError", PyExc_RuntimeError);
+  py::register_exception<Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);
+  m.def("extract_array", &extractArray);
+  m.def("write_arrays", &writeArrays);
+}

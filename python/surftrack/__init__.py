@@ -1,0 +1,201 @@
+"""surftrack: connected, watertight iso-surfaces of 3-D images (docs/python.md).
+
+One axis convention everywhere, the same as scikit-image's: a volume is indexed
+``volume[i, j, k]`` and a vertex's coordinates follow the array's axes, ``(i, j, k)`` times
+``spacing`` (plus ``origin``, through ``direction``). Whatever the memory order (C, Fortran,
+strided), the engine reads the array in place, without a copy.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from . import _surftrack
+from ._surftrack import Cancelled, InternalError, InvalidInput
+
+__all__ = ["extract", "marching_cubes", "Surface", "InvalidInput", "InternalError", "Cancelled"]
+
+_ADJACENCIES = ("26-6", "18-6", "6-18", "6-26")
+_MAPPINGS = ("linear", "midpoint", "default")
+
+
+@dataclass
+class Surface:
+    """A closed, oriented 2-manifold (one per component) whose vertices are boundary surfels.
+
+    vertices  (N, 3) float64, physical coordinates in the array's axis order
+    faces     (M, 3) int64, oriented: normals point from the selected voxels outwards
+    normals   (N, 3) float64, unit outward vertex normals
+    surfels   (N, 2, 3) int64, the voxel pair (c, d) of each vertex: c selected, d not
+    components  one dict per component (surfels, triangles, edges, euler, genus, area,
+              volume), by decreasing size
+    euler, genus  of the whole surface (sums over the components)
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    normals: np.ndarray
+    surfels: np.ndarray
+    components: list = field(default_factory=list)
+    euler: int = 0
+    boundaries_in_image: int = 0
+    mapping: str = "midpoint"
+    timings: dict = field(default_factory=dict)
+    seed_surfel: Optional[tuple] = None
+    seed_walk_steps: int = 0
+
+    @property
+    def genus(self) -> float:
+        return sum(c["genus"] for c in self.components)
+
+    def write(self, path: str, binary: bool = True) -> None:
+        """Writes .ply, .obj, .off or .stl (the CLI's writers; atomic: never a partial file)."""
+        _surftrack.write_arrays(self.vertices, self.faces, self.surfels, str(path), binary)
+
+
+def _as_volume(volume) -> np.ndarray:
+    array = np.asarray(volume)
+    if array.dtype.kind not in "biuf":
+        raise TypeError(f"unsupported volume dtype '{array.dtype}': expected bool, "
+                        "uint8/16/32/64, int8/16/32/64, float32 or float64")
+    if array.ndim != 3:
+        raise ValueError(f"the volume must be 3-D, not {array.ndim}-D")
+    if array.size == 0:
+        raise ValueError(f"the volume is empty (shape {array.shape})")
+    if not array.dtype.isnative:
+        array = array.astype(array.dtype.newbyteorder("="))
+    if array.dtype.kind == "b":
+        array = array.view(np.uint8)
+    if any(s % array.itemsize for s in array.strides):
+        array = np.ascontiguousarray(array)
+    return array
+
+
+def _triple(name: str, value, default) -> tuple:
+    value = default if value is None else value
+    out = tuple(float(v) for v in np.asarray(value, dtype=float).reshape(-1))
+    if len(out) != 3 or not all(np.isfinite(out)):
+        raise ValueError(f"{name} must be three finite numbers, not {value!r}")
+    return out
+
+
+def _range_note(array: np.ndarray, level: float) -> str:
+    lo, hi = float(np.nanmin(array)), float(np.nanmax(array))
+    if level < lo or level >= hi:
+        return f" (level {level:g} is outside the data range [{lo:g}, {hi:g}])"
+    return ""
+
+
+def extract(volume, *, level: Optional[float] = None, label: Optional[float] = None,
+            seed: Optional[Sequence] = None, seed_point: Optional[Sequence[float]] = None,
+            mode: str = "seed", adjacency: str = "26-6", mapping: str = "default",
+            spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
+            epsilon: float = 1e-3,
+            progress: Optional[Callable[[str, int, int, int], None]] = None) -> Surface:
+    """The surface of one boundary (mode="seed"), of the largest, or of all boundaries.
+
+    The selected voxels are ``volume > level`` or ``volume == label``. ``seed`` is a voxel index
+    ``(i, j, k)`` (the engine walks from it along the axes to the first boundary) or a surfel
+    ``((i, j, k), (i2, j2, k2))``; ``seed_point`` is a physical point. ``mapping`` places each
+    vertex on its surfel's segment: "linear" (iso-value interpolation, the default for a
+    level), "midpoint" (the default for a label). ``progress(stage, index, stages, surfels)``
+    is called at each stage and while tracking. Raises ValueError / TypeError on bad input.
+    """
+    array = _as_volume(volume)
+    if (level is None) == (label is None):
+        if level is None:
+            level = (float(np.nanmin(array)) + float(np.nanmax(array))) / 2.0
+        else:
+            raise ValueError("give either level or label, not both")
+    if mode not in ("seed", "largest", "all"):
+        raise ValueError(f"unknown mode '{mode}': expected 'seed', 'largest' or 'all'")
+    if adjacency not in _ADJACENCIES:
+        raise ValueError(f"unsupported adjacency pair '{adjacency}': expected one of "
+                         + ", ".join(_ADJACENCIES))
+    if mapping not in _MAPPINGS:
+        raise ValueError(f"unknown mapping '{mapping}': expected linear, midpoint or default")
+    seed_values = [0.0] * 6
+    if mode == "seed":
+        if (seed is None) == (seed_point is None):
+            raise ValueError("mode='seed' needs exactly one of seed= and seed_point= "
+                             "(or use mode='largest' / 'all')")
+        if seed_point is not None:
+            seed_kind = "point"
+            seed_values[:3] = _triple("seed_point", seed_point, None)
+        else:
+            s = np.asarray(seed)
+            if s.shape == (3,):
+                seed_kind, seed_values[:3] = "voxel", [float(v) for v in s]
+            elif s.shape == (2, 3):
+                seed_kind, seed_values = "surfel", [float(v) for v in s.reshape(-1)]
+            else:
+                raise ValueError(f"seed must be a voxel (i, j, k) or a surfel ((i, j, k), "
+                                 f"(i2, j2, k2)), not {seed!r}")
+            if any(v != int(v) for v in seed_values):
+                raise ValueError(f"seed indices must be integers, not {seed!r}")
+    else:
+        if seed is not None or seed_point is not None:
+            raise ValueError(f"mode='{mode}' takes no seed")
+        seed_kind = mode
+    spacing = _triple("spacing", spacing, (1.0, 1.0, 1.0))
+    if not all(s > 0 for s in spacing):
+        raise ValueError(f"spacing must be positive, not {spacing}")
+    origin = _triple("origin", origin, (0.0, 0.0, 0.0))
+    direction = np.eye(3) if direction is None else np.asarray(direction, dtype=float)
+    if direction.shape != (3, 3) or not np.all(np.isfinite(direction)):
+        raise ValueError("direction must be a 3x3 matrix of finite numbers")
+    # The engine's x, y, z are the array's last, middle, first axes, whatever the memory order:
+    # the triangulation of a cube's loops depends on the axes, and the same array must give
+    # the same surface. C order reads whole rows at a time (the fast path); other orders read
+    # voxel by voxel, in place.
+    order = [2, 1, 0]
+    kind, value = ("label", float(label)) if label is not None else ("threshold", float(level))
+    try:
+        out = _surftrack.extract_array(array, order, kind, value, seed_kind, seed_values,
+                                       adjacency, mapping, float(epsilon), spacing, origin,
+                                       direction.tolist(), progress)
+    except ValueError as error:
+        note = _range_note(array, value) if kind == "threshold" else ""
+        raise ValueError(f"{error}{note}") from None
+    return Surface(**out)
+
+
+def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_direction="descent",
+                   step_size=1, allow_degenerate=True, method="lewiner", mask=None,
+                   adjacency="26-6"):
+    """A drop-in for ``skimage.measure.marching_cubes`` whose output is always a closed,
+    oriented 2-manifold: every boundary of the image, by the scanning method.
+
+    Returns ``(verts, faces, normals, values)`` with scikit-image's shapes and dtypes. See
+    docs/python.md for what each argument does here and how the result differs.
+    """
+    array = _as_volume(volume)
+    lo, hi = float(np.nanmin(array)), float(np.nanmax(array))
+    level = (lo + hi) / 2.0 if level is None else float(level)
+    if not lo <= level <= hi:
+        raise ValueError("Surface level must be within volume data range.")
+    if method not in ("lewiner", "lorensen"):
+        raise ValueError("method should be either 'lewiner' or 'lorensen'")
+    if gradient_direction not in ("descent", "ascent"):
+        raise ValueError("Incorrect input %s in `gradient_direction`, see docstring." % gradient_direction)
+    if step_size != 1:
+        raise ValueError("step_size other than 1 is not supported: surftrack never skips voxels")
+    if mask is not None:
+        raise ValueError("mask is not supported by surftrack.marching_cubes")
+    surface = extract(array, level=level, mode="all", adjacency=adjacency, mapping="linear",
+                      spacing=spacing, epsilon=1e-9)
+    verts = surface.vertices.astype(np.float32)
+    faces = surface.faces.astype(np.int32)
+    normals = surface.normals.astype(np.float32)
+    # The larger of the two voxel values of each vertex's grid edge.
+    c, d = surface.surfels[:, 0], surface.surfels[:, 1]
+    inside = np.all((d >= 0) & (d < np.array(array.shape)), axis=1)
+    values = array[tuple(c.T)].astype(np.float32)
+    dv = array[tuple(np.where(inside[:, None], d, c).T)].astype(np.float32)
+    values = np.maximum(values, dv)
+    if gradient_direction == "ascent":
+        faces = faces[:, ::-1].copy()
+        normals = -normals
+    return verts, faces, normals, values
