@@ -1,7 +1,7 @@
-// The baseline issue 2 measures the tracker against: "a straightforward hash-set depth-first
-// traversal" of beta-adjacencies. It reads the image voxel by voxel through the reference
-// betaNeighbours (Definition 38) and keeps the visited surfels in an open-addressing hash set
-// keyed by Surfel::key(). It only visits: it builds no graph, so it does less than
+// The baseline bench_tracking measures the tracker against: a straightforward hash-set
+// depth-first traversal of beta-adjacencies. It reads the image voxel by voxel through the
+// reference betaNeighbours (Definition 38) and keeps the visited surfels in an open-addressing
+// hash set keyed by Surfel::key(). It only visits: it builds no graph, so it does less than
 // trackComponent and the speed ratio between the two is, if anything, in the baseline's favour.
 // Timing both in one run is what makes the ratio comparable across machines, whose absolute
 // speeds here drift by ±30 % (docs/performance.md).

@@ -1,5 +1,6 @@
-// The test image of the Figure 9 protocol (spec.md §7): a gray-level sphere with salt-and-pepper
-// noise, and the protocol's seed surfel. Shared by the scanning and Figure 9 benchmarks.
+// The test image of the Figure 9 protocol (paper §5.3; docs/figure9.md, 'Protocol'): a
+// gray-level sphere with salt-and-pepper noise, and the protocol's seed surfel. Shared by the
+// scanning and Figure 9 benchmarks.
 //  - unsigned 8-bit, side q, centre c = ((q-1)/2, (q-1)/2, (q-1)/2), R = 0.4 q,
 //    f(x) = clamp(round(128 + 20 (R - |x - c|)), 0, 255), iso-value s = 127.5;
 //  - noise p: the voxels are visited in buffer order (x fastest); for each one a 64-bit word r

@@ -1,7 +1,8 @@
-// Conversion throughput (issue 3): from a tracked surface graph to the indexed triangle list
+// Conversion throughput: from a tracked surface graph to the indexed triangle list
 // (extractLoops, paper §5.2) — from the image bricks the graph keeps, and for comparison from
 // the image itself, which binarises it again — then, separately, the iso-value mapping of the vertices and the
-// construction of the OpenMesh half-edge mesh, on the noisy spheres of spec.md §7.
+// construction of the OpenMesh half-edge mesh, on the noisy spheres of the Figure 9 protocol
+// (docs/figure9.md, 'Protocol').
 // Medians of several runs, one thread.
 //
 //   bench_conversion [--sizes 64,128,...] [--reps N] [--pair 26-6]

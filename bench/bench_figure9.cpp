@@ -1,5 +1,5 @@
-// Figure 9 of Lachaud & Montanvert (paper §5.3), reproduced with the protocol of spec.md §7:
-// extracting ONE connected iso-surface of a noisy gray sphere
+// Figure 9 of Lachaud & Montanvert (paper §5.3), reproduced with the protocol of
+// docs/figure9.md, 'Protocol': extracting ONE connected iso-surface of a noisy gray sphere
 //   method 1  : scanning the whole q^3 image with the configuration table (scanIsoSurface);
 //   method 1b : method 1, then keeping the seed's component (extractComponent) — what a user of
 //               a marching-cubes tool must do to get one kappa-lambda-boundary;

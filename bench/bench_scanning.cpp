@@ -1,5 +1,6 @@
-// Throughput of the scanning method (method 1 of Figure 9): scanIsoSurface on the spec §7
-// sphere, single thread, median of several runs, for each side q and noise level.
+// Throughput of the scanning method (method 1 of Figure 9): scanIsoSurface on the sphere of the
+// Figure 9 protocol (docs/figure9.md, 'Protocol'), single thread, median of several runs, for
+// each side q and noise level.
 //
 //   bench_scanning [--runs N] [--q 128,256,512] [--noise 0,0.01,0.05] [--pair 26-6] [--no-generic]
 //                  [--cpu-time]

@@ -1,10 +1,10 @@
-// Tracking throughput (issue 2): surfels per second of trackComponent, single thread, on the
-// noisy spheres of the Figure 9 protocol (spec.md §7), and on an implicit ball of radius 900 in
-// a 4096^3 domain that can be neither stored nor scanned. Memory is the tracker's own peak:
-// each case runs in a child process that reports its peak resident size minus its size just
-// before tracking (so the stored image does not count). Each case also times, in the same run,
-// the baseline issue 2 names, a hash-set depth-first traversal (HashSetTraversal.h), and
-// prints the speed ratio: absolute speeds drift between runs on a VM, the ratio much less.
+// Tracking throughput: surfels per second of trackComponent, single thread, on the noisy
+// spheres of the Figure 9 protocol (docs/figure9.md, 'Protocol'), and on an implicit ball of
+// radius 900 in a 4096^3 domain that can be neither stored nor scanned. Memory is the tracker's
+// own peak: each case runs in a child process that reports its peak resident size minus its size
+// just before tracking (so the stored image does not count). Each case also times, in the same
+// run, the baseline, a hash-set depth-first traversal (HashSetTraversal.h), and prints the
+// speed ratio: absolute speeds drift between runs on a VM, the ratio much less.
 //
 // With --breakdown, two parts of the tracker's work are also timed on their own, each in the
 // same kind of child process: binarising the bricks the surface passes through (the tracker's

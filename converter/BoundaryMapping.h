@@ -1,7 +1,8 @@
-// Boundary mappings (paper §3.1, spec §6): a mapping h sends each boundary surfel (c, d) to a
-// point of the open segment ]c, d[. The mesh connectivity comes from the midpoint tables (§5.1)
-// whatever h is; h only places the vertices ("move the boundary vertices according to h but on
-// the triangles computed with the trivial boundary mapping", §5.1).
+// Boundary mappings (paper §3.1; docs/theory.md, 'Boundary mappings'): a mapping h sends each
+// boundary surfel (c, d) to a point of the open segment ]c, d[. The mesh connectivity comes
+// from the midpoint tables (§5.1) whatever h is; h only places the vertices ("move the boundary
+// vertices according to h but on the triangles computed with the trivial boundary mapping",
+// §5.1).
 //
 // A mapping is any callable `std::array<double, 3>(const Surfel&)` giving index-space
 // coordinates; physical coordinates are applied afterwards with ImageGeometry::toPhysical.

@@ -18,7 +18,8 @@
 //
 // The image must be constant outside its domain (as every image of Image.h is): the cubes
 // scanned are those with min corner in [-1, n - 1] on each axis, so that every boundary is
-// closed, also where an object touches the domain border (spec.md §1).
+// closed, also where an object touches the domain border (docs/theory.md, 'Images, voxels and the
+// domain').
 #pragma once
 
 #include <cmath>

@@ -1,8 +1,8 @@
 // The beta^{kappa lambda} adjacency between boundary surfels (paper Definition 38, Figure 7),
-// in the per-edge form of spec.md §2: across each of the 4 edges of a surfel's square there is
-// exactly one neighbour (rules (i)–(iii)); with kappa = 26 (lambda = 26) each strict
-// 26-configuration of 1-voxels (0-voxels) among the surfel's 4 digital 3-cubes adds 2 "vertex"
-// links (rule (iv)).
+// in the per-edge form of docs/theory.md, 'The beta-adjacency': across each of the 4 edges of a
+// surfel's square there is exactly one neighbour (rules (i)–(iii)); with kappa = 26
+// (lambda = 26) each strict 26-configuration of 1-voxels (0-voxels) among the surfel's 4
+// digital 3-cubes adds 2 "vertex" links (rule (iv)).
 #pragma once
 
 #include <array>

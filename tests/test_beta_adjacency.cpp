@@ -103,7 +103,7 @@ TEST(Strict26, NonStrictDiagonalGetsNoVertexLinks) {
 
 TEST(EdgeRule, Kappa6TurnsInwardWhereKappa18TurnsOutward) {
   // Two 1-voxels sharing only an edge: a = I(u+e) = 0, b = I(u+n+e) = 1 for the surfel between
-  // them (spec §2, last row of the table).
+  // them (docs/theory.md, 'The beta-adjacency', the case a = 0, b = 1 of the edge rule).
   BinaryVolume volume({2, 2, 1});
   volume.at(0, 0, 0) = volume.at(1, 1, 0) = 1;
   const auto image = binaryView(volume);

@@ -1,6 +1,7 @@
 // The configuration tables (§5.1, Definition 9) against independent properties, for all
 // 4 pairs x 256 configurations: vertices = cut edges; triangle edges on cube faces = the
-// beta-arcs of Definition 38 (i)-(iii) computed from the per-edge rule of spec.md §2;
+// beta-arcs of Definition 38 (i)-(iii) computed from the per-edge rule (docs/theory.md,
+// 'The beta-adjacency');
 // closedness and orientation within a cube and across neighbouring cubes; supporting planes of
 // the local volume; the strict-26 tube; patches = triangulated loops; regeneration.
 #include <gtest/gtest.h>
@@ -63,8 +64,8 @@ std::string where(AdjacencyPair pair, int config) {
 }
 
 // The beta-neighbour of the surfel on cut edge k across the cube face spanned by its edge and
-// `axis`, by the 4-row rule of spec.md §2 (Definition 38 (i)-(iii)): u the 1-voxel, u+n the
-// 0-voxel, e the unit vector along `axis` pointing into the cube.
+// `axis`, by the 4-row rule of docs/theory.md, 'The beta-adjacency' (Definition 38 (i)-(iii)):
+// u the 1-voxel, u+n the 0-voxel, e the unit vector along `axis` pointing into the cube.
 int betaNeighbourInFace(AdjacencyPair pair, int config, int k, int axis) {
   const int u = oneCorner(config, k), un = zeroCorner(config, k), e = 1 << axis;
   const bool a = on(config, u ^ e), b = on(config, un ^ e);
@@ -198,7 +199,7 @@ std::set<Arc> directedFaceArcs(const CubeTriangulation& t, int axis, int side) {
 
 // Across the face shared by two neighbouring cubes, the arcs of one cube are exactly the
 // reversed arcs of the other, whatever the other 4 voxels: together the tables give a closed
-// oriented surface (spec.md §4).
+// oriented surface (paper §5.2; docs/theory.md, 'Loops and their triangulation').
 TEST(ConfigurationTables, FaceArcsAreReversedInTheNeighbouringCube) {
   for (AdjacencyPair pair : kAllAdjacencyPairs)
     for (int axis = 0; axis < 3; ++axis) {

@@ -141,7 +141,8 @@ double windingNumber(const TriangleMesh& mesh, const std::vector<Point>& p, cons
 }
 
 // ---------------------------------------------------------------------------------------------
-// Euler characteristic of a kappa-component O, from its voxels only (spec §8).
+// Euler characteristic of a kappa-component O, from its voxels only (docs/theory.md, 'Euler
+// characteristic and genus').
 
 /// kappa = 26: the union of the closed unit cubes centred at O's voxels. In doubled coordinates
 /// its cells are the points 2v + {-1,0,1}^3; a cell's dimension is its number of even coordinates.

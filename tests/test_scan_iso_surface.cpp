@@ -70,7 +70,7 @@ std::vector<Triple> referenceTriples(const BinaryImage& image, AdjacencyPair pai
   return out;
 }
 
-/// The 1,000+ random images of the brief: sides 3..16 (not necessarily cubic), density 0.1..0.9.
+/// 1,000+ random images: sides 3..16 (not necessarily cubic), density 0.1..0.9.
 std::vector<BinaryVolume> randomImages(int count, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::vector<BinaryVolume> out;

@@ -83,7 +83,8 @@ class BetaNeighbourTable {
     return count;
   }
 
-  /// The rule across one edge of a surfel with normal n (spec.md §2's table).
+  /// The rule across one edge of a surfel with normal n (the table of docs/theory.md, 'The
+  /// beta-adjacency').
   struct EdgeRule {
     std::uint8_t aBit = 0, bBit = 0;  // neighbourhood bits of u+e and u+n+e
     std::array<Surfel, 4> result{};   // neighbour relative to u, by a | b << 1
