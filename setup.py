@@ -1,0 +1,36 @@
+"""Builds the extension module of the Python package with the project's CMake build (only the
+front door and the module: no CLI, no tests), for the interpreter that runs pip."""
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
+
+ROOT = Path(__file__).resolve().parent
+
+
+class CMakeExtension(Extension):
+    def __init__(self, name):
+        super().__init__(name, sources=[])
+
+
+class CMakeBuild(build_ext):
+    def build_extension(self, ext):
+        target = Path(self.get_ext_fullpath(ext.name)).resolve()
+        build = Path(self.build_temp).resolve() / "cmake"
+        build.mkdir(parents=True, exist_ok=True)
+        subprocess.run(["cmake", "-S", str(ROOT), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
+                        "-DSURFTRACK_BUILD_CLI=OFF", "-DSURFTRACK_BUILD_TESTS=OFF",
+                        "-DSURFTRACK_SHARED=OFF", f"-DPython3_EXECUTABLE={sys.executable}"],
+                       check=True)
+        subprocess.run(["cmake", "--build", str(build), "--target", "_surftrack", "-j",
+                        str(os.cpu_count() or 2)], check=True)
+        built = next((build / "python" / "surftrack").glob("_surftrack*.so"))
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(built, target)
+
+
+setup(ext_modules=[CMakeExtension("surftrack._surftrack")], cmdclass={"build_ext": CMakeBuild})
