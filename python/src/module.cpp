@@ -35,12 +35,45 @@ ScalarType scalarTypeOfDtype(const py::dtype& dtype) {
                        "': expected bool, uint8/16/32/64, int8/16/32/64, float32 or float64");
 }
 
-template <class T>
-py::array_t<T> toArray(const std::vector<T>& flat, std::vector<py::ssize_t> shape) {
-  py::array_t<T> out(shape);
-  std::copy(flat.begin(), flat.end(), out.mutable_data());
-  return out;
+/// A numpy array over `data` (shape `shape`), owned by the heap object `owner`: no copy.
+template <class T, class Owner>
+py::array_t<T> viewOf(T* data, std::vector<py::ssize_t> shape, std::shared_ptr<Owner> owner) {
+  auto* keep = new std::shared_ptr<Owner>(std::move(owner));
+  py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<Owner>*>(p); });
+  return py::array_t<T>(shape, data, base);
 }
+
+/// An extracted surface held for Python: its vectors are the numpy arrays (no copy); normals
+/// and surfels in array axes are computed on first use, without the GIL.
+struct Result {
+  Surface surface;
+  std::array<int, 3> order{};  // engine axis e is array axis order[e]
+
+  static py::array normals(const std::shared_ptr<Result>& r) {
+    auto normals = std::make_shared<std::vector<std::array<double, 3>>>();
+    {
+      py::gil_scoped_release release;
+      *normals = vertexNormals(r->surface);
+    }
+    return viewOf(normals->front().data(), {py::ssize_t(normals->size()), 3}, normals);
+  }
+  static py::array surfels(const std::shared_ptr<Result>& r) {
+    auto out = std::make_shared<std::vector<std::int32_t>>(6 * r->surface.surfels.size());
+    {
+      py::gil_scoped_release release;
+      std::int32_t* o = out->data();
+      for (const Surfel& sv : r->surface.surfels) {
+        const Voxel c = sv.inside(), d = sv.outside();
+        for (int e = 0; e < 3; ++e) {  // back to array axes
+          o[r->order[e]] = c[e];
+          o[3 + r->order[e]] = d[e];
+        }
+        o += 6;
+      }
+    }
+    return viewOf(out->data(), {py::ssize_t(r->surface.surfels.size()), 2, 3}, out);
+  }
+};
 
 /// Runs extract() on `volume` whose engine axes x, y, z are the array axes order[0..2].
 py::dict extractArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
@@ -96,39 +129,19 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     if (!progress.is_none()) progress(e.stage, e.index, e.stages, e.surfels);
   };
 
-  Surface s;
-  std::vector<std::array<double, 3>> normals;
+  auto r = std::make_shared<Result>();
+  r->order = order;
   {
     py::gil_scoped_release release;
-    s = extract(view, o);
-    normals = vertexNormals(s);
+    r->surface = extract(view, o);
   }
-
+  const Surface& s = r->surface;
   const py::ssize_t n = py::ssize_t(s.vertices.size()), m = py::ssize_t(s.triangles.size());
-  py::array_t<double> vertices({n, py::ssize_t(3)}), normalArray({n, py::ssize_t(3)});
-  py::array_t<std::int64_t> faces({m, py::ssize_t(3)});
-  py::array_t<std::int64_t> surfels({n, py::ssize_t(2), py::ssize_t(3)});
-  py::array_t<double> gray({n, py::ssize_t(2)});
-  {
-    auto v = vertices.mutable_unchecked<2>();
-    auto nn = normalArray.mutable_unchecked<2>();
-    auto sf = surfels.mutable_unchecked<3>();
-    for (py::ssize_t i = 0; i < n; ++i) {
-      const Surfel& sv = s.surfels[std::size_t(i)];
-      const Voxel c = sv.inside(), d = sv.outside();
-      for (int k = 0; k < 3; ++k) {
-        v(i, k) = s.vertices[std::size_t(i)][k];
-        nn(i, k) = normals[std::size_t(i)][k];
-      }
-      for (int e = 0; e < 3; ++e) {  // back to array axes
-        sf(i, 0, order[e]) = c[e];
-        sf(i, 1, order[e]) = d[e];
-      }
-    }
-    auto f = faces.mutable_unchecked<2>();
-    for (py::ssize_t t = 0; t < m; ++t)
-      for (int k = 0; k < 3; ++k) f(t, k) = s.triangles[std::size_t(t)][k];
-  }
+  static_assert(sizeof(std::array<double, 3>) == 3 * sizeof(double));
+  static_assert(sizeof(std::array<std::uint32_t, 3>) == 3 * sizeof(std::uint32_t));
+  // (A surface is never empty: extract() throws instead.)
+  py::array vertices = viewOf(const_cast<double*>(s.vertices.front().data()), {n, 3}, r);
+  py::array faces = viewOf(const_cast<std::uint32_t*>(s.triangles.front().data()), {m, 3}, r);
   py::list components;
   for (const ComponentFigures& c : s.components) {
     py::dict d;
@@ -146,8 +159,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
   py::dict out;
   out["vertices"] = vertices;
   out["faces"] = faces;
-  out["normals"] = normalArray;
-  out["surfels"] = surfels;
+  out["result"] = r;
   out["components"] = components;
   out["euler"] = s.euler;
   out["boundaries_in_image"] = s.boundariesInImage;
@@ -204,6 +216,9 @@ PYBIND11_MODULE(_surftrack, m) {
   py::register_exception<InvalidInput>(m, "InvalidInput", PyExc_ValueError);
   py::register_exception<InternalError>(m, "InternalError", PyExc_RuntimeError);
   py::register_exception<Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);
+  py::class_<Result, std::shared_ptr<Result>>(m, "Result")
+      .def("normals", &Result::normals)
+      .def("surfels", &Result::surfels);
   m.def("extract_array", &extractArray);
   m.def("write_arrays", &writeArrays);
 }

@@ -7,7 +7,6 @@ strided), the engine reads the array in place, without a copy.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -21,34 +20,56 @@ _ADJACENCIES = ("26-6", "18-6", "6-18", "6-26")
 _MAPPINGS = ("linear", "midpoint", "default")
 
 
-@dataclass
 class Surface:
     """A closed, oriented 2-manifold (one per component) whose vertices are boundary surfels.
 
     vertices  (N, 3) float64, physical coordinates in the array's axis order
-    faces     (M, 3) int64, oriented: normals point from the selected voxels outwards
-    normals   (N, 3) float64, unit outward vertex normals
-    surfels   (N, 2, 3) int64, the voxel pair (c, d) of each vertex: c selected, d not
+    faces     (M, 3) uint32, oriented: normals point from the selected voxels outwards
+    normals   (N, 3) float64, unit outward vertex normals (computed on first use)
+    surfels   (N, 2, 3) int32, the voxel pair (c, d) of each vertex: c selected, d not, as
+              array indices (computed on first use)
     components  one dict per component (surfels, triangles, edges, euler, genus, area,
               volume), by decreasing size
     euler, genus  of the whole surface (sums over the components)
+    boundaries_in_image  mode "largest" / "all": the boundaries the scan found
+    timings   seconds per stage of the C++ core
     """
 
-    vertices: np.ndarray
-    faces: np.ndarray
-    normals: np.ndarray
-    surfels: np.ndarray
-    components: list = field(default_factory=list)
-    euler: int = 0
-    boundaries_in_image: int = 0
-    mapping: str = "midpoint"
-    timings: dict = field(default_factory=dict)
-    seed_surfel: Optional[tuple] = None
-    seed_walk_steps: int = 0
+    def __init__(self, vertices, faces, result=None, normals=None, surfels=None, components=(),
+                 euler=0, boundaries_in_image=0, mapping="midpoint", timings=None,
+                 seed_surfel=None, seed_walk_steps=0):
+        self.vertices = vertices
+        self.faces = faces
+        self._result = result
+        self._normals = normals
+        self._surfels = surfels
+        self.components = list(components)
+        self.euler = euler
+        self.boundaries_in_image = boundaries_in_image
+        self.mapping = mapping
+        self.timings = dict(timings or {})
+        self.seed_surfel = seed_surfel
+        self.seed_walk_steps = seed_walk_steps
+
+    @property
+    def normals(self) -> np.ndarray:
+        if self._normals is None:
+            self._normals = self._result.normals()
+        return self._normals
+
+    @property
+    def surfels(self) -> np.ndarray:
+        if self._surfels is None:
+            self._surfels = self._result.surfels()
+        return self._surfels
 
     @property
     def genus(self) -> float:
         return sum(c["genus"] for c in self.components)
+
+    def __repr__(self) -> str:
+        return (f"Surface({len(self.vertices)} vertices, {len(self.faces)} triangles, "
+                f"{len(self.components)} component(s), euler {self.euler})")
 
     def write(self, path: str, binary: bool = True) -> None:
         """Writes .ply, .obj, .off or .stl (the CLI's writers; atomic: never a partial file)."""
@@ -81,6 +102,17 @@ def _triple(name: str, value, default) -> tuple:
     return out
 
 
+def _split_affine(affine):
+    """spacing, origin, direction of a 4x4 affine index -> world map (columns: the axes)."""
+    a = np.asarray(affine, dtype=float)
+    if a.shape != (4, 4) or not np.all(np.isfinite(a)) or not np.allclose(a[3], [0, 0, 0, 1]):
+        raise ValueError("affine must be a 4x4 matrix with last row (0, 0, 0, 1)")
+    spacing = np.linalg.norm(a[:3, :3], axis=0)
+    if not np.all(spacing > 0):
+        raise ValueError("affine has a zero column: the geometry is singular")
+    return tuple(spacing), tuple(a[:3, 3]), a[:3, :3] / spacing
+
+
 def _range_note(array: np.ndarray, level: float) -> str:
     lo, hi = float(np.nanmin(array)), float(np.nanmax(array))
     if level < lo or level >= hi:
@@ -91,7 +123,7 @@ def _range_note(array: np.ndarray, level: float) -> str:
 def extract(volume, *, level: Optional[float] = None, label: Optional[float] = None,
             seed: Optional[Sequence] = None, seed_point: Optional[Sequence[float]] = None,
             mode: str = "seed", adjacency: str = "26-6", mapping: str = "default",
-            spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
+            spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, affine=None,
             epsilon: float = 1e-3,
             progress: Optional[Callable[[str, int, int, int], None]] = None) -> Surface:
     """The surface of one boundary (mode="seed"), of the largest, or of all boundaries.
@@ -101,9 +133,13 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     ``((i, j, k), (i2, j2, k2))``; ``seed_point`` is a physical point. ``mapping`` places each
     vertex on its surfel's segment: "linear" (iso-value interpolation, the default for a
     level), "midpoint" (the default for a label). ``progress(stage, index, stages, surfels)``
-    is called at each stage and while tracking. Raises ValueError / TypeError on bad input.
+    is called at each stage and while tracking. ``affine`` (a 4x4 voxel-to-world matrix, as
+    nibabel's ``img.affine``) replaces spacing, origin and direction. Raises ValueError /
+    TypeError on bad input.
     """
     array = _as_volume(volume)
+    if affine is not None:
+        spacing, origin, direction = _split_affine(affine)
     if (level is None) == (label is None):
         if level is None:
             level = (float(np.nanmin(array)) + float(np.nanmax(array))) / 2.0
@@ -151,6 +187,10 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     # the same surface. C order reads whole rows at a time (the fast path); other orders read
     # voxel by voxel, in place.
     order = [2, 1, 0]
+    if seed_kind in ("largest", "all") and not array.flags.c_contiguous:
+        # The scan reads every voxel row by row: one C-ordered copy is faster than reading
+        # across memory, and it is read once anyway (a seeded extraction never copies).
+        array = np.ascontiguousarray(array)
     kind, value = ("label", float(label)) if label is not None else ("threshold", float(level))
     try:
         out = _surftrack.extract_array(array, order, kind, value, seed_kind, seed_values,
