@@ -27,8 +27,8 @@ struct VolumeView {
   }
   /// The view of a strided buffer (strides in elements, any sign).
   template <class T>
-  static VolumeView of(const T* data, Dims dims, std::array<std::ptrdiff_t, 3> strides,
-                       const ImageGeometry& geometry = {}) {
+  static VolumeView strided(const T* data, Dims dims, std::array<std::ptrdiff_t, 3> strides,
+                            const ImageGeometry& geometry = {}) {
     return VolumeView{data, scalarTypeOf<T>(), dims, strides, geometry};
   }
 };

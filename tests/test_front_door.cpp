@@ -1,0 +1,275 @@
+// The front door (core/, docs/api.md): extract() over views and sources, against the engine
+// called directly and against counts computed here from the voxels; what it reads and allocates
+// on a seeded path; its typed errors, progress and cancellation.
+#include <gtest/gtest.h>
+
+#include <surftrack/Extract.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <new>
+#include <random>
+#include <vector>
+
+#include "Image.h"
+#include "LoopExtraction.h"
+#include "TrackComponent.h"
+
+using namespace surftrack;
+
+// Every allocation of this test program is counted, so that a test can measure the peak of the
+// bytes allocated while extract() runs (an independent check that a seeded extraction over a
+// view allocates nothing proportional to the volume).
+namespace {
+std::atomic<std::size_t> gLive{0}, gPeak{0};
+}  // namespace
+void* operator new(std::size_t n) {
+  void* p = std::malloc(n + 16);
+  if (!p) throw std::bad_alloc();
+  *static_cast<std::size_t*>(p) = n;
+  const std::size_t live = gLive += n;
+  for (std::size_t peak = gPeak; live > peak && !gPeak.compare_exchange_weak(peak, live);) {}
+  return static_cast<char*>(p) + 16;
+}
+void operator delete(void* p) noexcept {
+  if (!p) return;
+  char* base = static_cast<char*>(p) - 16;
+  gLive -= *reinterpret_cast<std::size_t*>(base);
+  std::free(base);
+}
+void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
+
+namespace {
+
+/// A gray ball f = 100 (r - |x - c|) with noise specks, of type T.
+template <class T>
+std::vector<T> noisyBall(Dims d, double r, unsigned seed) {
+  std::vector<T> v(d.count());
+  std::mt19937 rng(seed);
+  for (int z = 0; z < d.nz; ++z)
+    for (int y = 0; y < d.ny; ++y)
+      for (int x = 0; x < d.nx; ++x) {
+        const double dist = std::sqrt((x - d.nx / 2.0) * (x - d.nx / 2.0) + (y - d.ny / 2.0) * (y - d.ny / 2.0) +
+                                      (z - d.nz / 2.0) * (z - d.nz / 2.0));
+        double f = std::clamp(50 + 20 * (r - dist), 0.0, 120.0);
+        if (rng() % 50 == 0) f = 120 - f;
+        v[(std::size_t(z) * d.ny + y) * d.nx + x] = T(f);
+      }
+  return v;
+}
+
+/// The number of 6-adjacent (selected, not selected) voxel pairs, the domain border included.
+template <class T>
+std::size_t boundaryPairs(const std::vector<T>& v, Dims d, double s) {
+  auto on = [&](int x, int y, int z) { return d.contains(x, y, z) && double(v[(std::size_t(z) * d.ny + y) * d.nx + x]) > s; };
+  std::size_t n = 0;
+  for (int z = 0; z < d.nz; ++z)
+    for (int y = 0; y < d.ny; ++y)
+      for (int x = 0; x < d.nx; ++x)
+        if (on(x, y, z))
+          for (Direction k = 0; k < 6; ++k) {
+            const Voxel u = Voxel{x, y, z} + unitVector(k);
+            n += !on(u.x, u.y, u.z);
+          }
+  return n;
+}
+
+/// A source that counts the voxels it is asked for.
+class CountingSource final : public VoxelSource {
+ public:
+  explicit CountingSource(const VoxelSource& inner) : inner_(inner) {}
+  Dims dims() const override { return inner_.dims(); }
+  ImageGeometry geometry() const override { return inner_.geometry(); }
+  ScalarType type() const override { return inner_.type(); }
+  void binaryBlock(const Selection& s, Voxel o, int w, int ny, int nz, std::uint16_t* out) const override {
+    read += std::size_t(w) * ny * nz;
+    inner_.binaryBlock(s, o, w, ny, nz, out);
+  }
+  std::uint64_t binaryRow(const Selection& s, Voxel start, int count) const override {
+    read += std::size_t(count);
+    return inner_.binaryRow(s, start, count);
+  }
+  void values(const Voxel* v, std::size_t n, double* out) const override {
+    read += n;
+    inner_.values(v, n, out);
+  }
+  mutable std::size_t read = 0;
+
+ private:
+  const VoxelSource& inner_;
+};
+
+TEST(FrontDoor, EveryScalarTypeAndTheEngineGiveTheSameSurface) {
+  const Dims d{23, 20, 17};
+  const std::vector<std::uint8_t> ref = noisyBall<std::uint8_t>(d, 6, 1);
+  ExtractOptions o;
+  o.selection = Selection::threshold(60.5);
+  o.seed = SeedRule::all();
+  o.mapping = Mapping::Midpoint;
+  const Surface base = extract(VolumeView::of(ref.data(), d), o);
+  EXPECT_EQ(base.surfels.size(), boundaryPairs(ref, d, 60.5));
+  EXPECT_GT(base.components.size(), 1u);  // the ball and the noise specks
+
+  // The engine, called directly on the same image.
+  const DenseImage<std::uint8_t> dense = [&] {
+    DenseImage<std::uint8_t> im(d);
+    std::copy(ref.begin(), ref.end(), im.data().begin());
+    return im;
+  }();
+  const ThresholdImage<std::uint8_t> binary(dense, 60.5);
+  o.seed = SeedRule::largest();
+  const Surface largest = extract(VolumeView::of(ref.data(), d), o);
+  const TriangleMesh direct = extractLoops(trackComponent(binary, *largest.seed.surfel, AdjacencyPair::k26_6));
+  EXPECT_EQ(largest.surfels, direct.surfels);
+  EXPECT_EQ(largest.triangles, direct.triangles);
+
+  auto same = [&](auto zero) {
+    using T = decltype(zero);
+    std::vector<T> v(ref.begin(), ref.end());
+    ExtractOptions all = o;
+    all.seed = SeedRule::all();
+    const Surface s = extract(VolumeView::of(v.data(), d), all);
+    EXPECT_EQ(s.surfels, base.surfels) << toString(scalarTypeOf<T>());
+    EXPECT_EQ(s.triangles, base.triangles) << toString(scalarTypeOf<T>());
+  };
+  same(std::int8_t{}), same(std::uint16_t{}), same(std::int16_t{}), same(std::uint32_t{});
+  same(std::int32_t{}), same(std::uint64_t{}), same(std::int64_t{}), same(float{}), same(double{});
+
+  // A function source of the same values gives the same surface.
+  const auto f = makeFunctionSource(d, [&](int x, int y, int z) { return double(dense.at(x, y, z)); });
+  o.seed = SeedRule::all();
+  const Surface fs = extract(*f, o);
+  EXPECT_EQ(fs.surfels, base.surfels);
+  EXPECT_EQ(fs.triangles, base.triangles);
+}
+
+TEST(FrontDoor, StridedViewsReadTheSameVoxels) {
+  const Dims d{19, 21, 18};
+  const std::vector<float> ref = noisyBall<float>(d, 7, 2);
+  // The same volume with x running backwards and y with a gap of 3 elements per row.
+  const std::ptrdiff_t sy = d.nx + 3, sz = sy * d.ny;
+  std::vector<float> padded(std::size_t(sz) * d.nz, -1.0f);
+  for (int z = 0; z < d.nz; ++z)
+    for (int y = 0; y < d.ny; ++y)
+      for (int x = 0; x < d.nx; ++x) padded[z * sz + y * sy + (d.nx - 1 - x)] = ref[(std::size_t(z) * d.ny + y) * d.nx + x];
+  ExtractOptions o;
+  o.selection = Selection::threshold(60);
+  o.seed = SeedRule::all();
+  const Surface a = extract(VolumeView::of(ref.data(), d), o);
+  const Surface b = extract(VolumeView::strided(padded.data() + d.nx - 1, d, {-1, sy, sz}), o);
+  EXPECT_EQ(a.surfels, b.surfels);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.vertices, b.vertices);
+}
+
+TEST(FrontDoor, ASeededExtractionReadsAndAllocatesOnlyNearTheSurface) {
+  // 256 MiB of voxels, one ball of radius 20 in it.
+  const Dims d{1024, 512, 512};
+  std::vector<std::uint8_t> volume(d.count(), 0);
+  const int c = 256, r = 20;
+  for (int z = c - r; z <= c + r; ++z)
+    for (int y = c - r; y <= c + r; ++y)
+      for (int x = c - r; x <= c + r; ++x)
+        if ((x - c) * (x - c) + (y - c) * (y - c) + (z - c) * (z - c) <= r * r)
+          volume[(std::size_t(z) * d.ny + y) * d.nx + x] = 200;
+  const auto view = makeViewSource(VolumeView::of(volume.data(), d));
+  const CountingSource counting(*view);
+  ExtractOptions o;
+  o.selection = Selection::threshold(100);
+  o.seed = SeedRule::fromVoxel({c, c, c});
+  const std::size_t before = gLive;
+  gPeak = before;
+  const Surface s = extract(counting, o);
+  const std::size_t peak = gPeak - before;
+  EXPECT_EQ(s.euler, 2);
+  // Reads: the bricks around the surface (1000 voxels each), the walk to it, the gray values.
+  EXPECT_LT(counting.read, 100 * s.surfels.size()) << counting.read << " voxels read";
+  // Memory: a few hundred bytes per surfel, nothing near the 256 MiB of the volume.
+  EXPECT_LT(peak, 1000 * s.surfels.size()) << peak << " bytes for " << s.surfels.size() << " surfels";
+  EXPECT_LT(peak, d.count() / 100);
+}
+
+TEST(FrontDoor, FiguresMirrorsAndSeeds) {
+  const Dims d{30, 30, 30};
+  const std::vector<std::uint8_t> v = noisyBall<std::uint8_t>(d, 9, 3);
+  ExtractOptions o;
+  o.selection = Selection::threshold(60.5);
+  o.seed = SeedRule::fromVoxel({15, 15, 15});
+  ImageGeometry g;
+  g.spacing = {0.5, 1, 2};
+  const Surface s = extract(VolumeView::of(v.data(), d, g), o);
+  ASSERT_EQ(s.components.size(), 1u);
+  const ComponentFigures& f = s.components[0];
+  EXPECT_EQ(f.surfels, s.surfels.size());
+  EXPECT_EQ(f.triangles, s.triangles.size());
+  EXPECT_EQ(2 * f.edges, 3 * f.triangles);
+  EXPECT_EQ(f.euler, (long long)f.surfels - (long long)f.edges + (long long)f.triangles);
+  EXPECT_GT(f.volume, 0);
+  // A mirrored frame gives the mirrored vertices and the same outward volume.
+  ImageGeometry m = g;
+  m.direction = {{{-1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  const Surface sm = extract(VolumeView::of(v.data(), d, m), o);
+  ASSERT_EQ(sm.vertices.size(), s.vertices.size());
+  for (std::size_t i = 0; i < s.vertices.size(); ++i) EXPECT_DOUBLE_EQ(sm.vertices[i][0], -s.vertices[i][0]);
+  EXPECT_NEAR(sm.components[0].volume, f.volume, 1e-9 * f.volume);
+  // The seed point at the same place as the voxel, in physical coordinates.
+  o.seed = SeedRule::point(g.toPhysical({15, 15, 15}));
+  EXPECT_EQ(extract(VolumeView::of(v.data(), d, g), o).surfels, s.surfels);
+}
+
+TEST(FrontDoor, ProgressAndCancellation) {
+  const Dims d{40, 40, 40};
+  const std::vector<std::uint8_t> v = noisyBall<std::uint8_t>(d, 12, 4);
+  ExtractOptions o;
+  o.selection = Selection::threshold(60.5);
+  o.seed = SeedRule::fromVoxel({20, 20, 20});
+  std::vector<std::string> stages;
+  o.progress = [&](const ProgressEvent& e) {
+    if (!e.surfels) stages.push_back(e.stage);
+  };
+  const Surface s = extract(VolumeView::of(v.data(), d), o);
+  EXPECT_EQ(stages, (std::vector<std::string>{"seed", "track", "convert", "place", "figures"}));
+  ASSERT_EQ(s.timings.size(), stages.size());
+  std::atomic<bool> cancel{true};
+  o.cancel = &cancel;
+  EXPECT_THROW(extract(VolumeView::of(v.data(), d), o), Cancelled);
+}
+
+TEST(FrontDoor, BadInputIsInvalidInputNamingTheValue) {
+  const Dims d{10, 10, 10};
+  std::vector<std::uint8_t> v(d.count(), 0);
+  v[555] = 9;
+  auto message = [&](ExtractOptions o, const VolumeView& view) -> std::string {
+    try {
+      extract(view, o);
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "no InvalidInput";
+  };
+  const VolumeView view = VolumeView::of(v.data(), d);
+  ExtractOptions o;
+  o.selection = Selection::label(300);
+  o.seed = SeedRule::all();
+  EXPECT_NE(message(o, view).find("label 300 is not a value of uint8"), std::string::npos);
+  o.selection = Selection::threshold(100);
+  EXPECT_NE(message(o, view).find("empty selection"), std::string::npos);
+  o.seed = SeedRule::fromVoxel({20, 1, 1});
+  EXPECT_NE(message(o, view).find("seed voxel (20,1,1) lies outside the image domain [0,10)x[0,10)x[0,10)"),
+            std::string::npos);
+  o.seed = SeedRule::fromVoxel({1, 1, 1});
+  EXPECT_NE(message(o, view).find("not on any boundary"), std::string::npos);
+  o.seed = SeedRule::fromSurfel(Surfel{{1, 1, 1}, 0});
+  o.selection = Selection::threshold(5);
+  EXPECT_NE(message(o, view).find("is not a boundary surfel"), std::string::npos);
+  o.selection = Selection::label(9);
+  o.mapping = Mapping::Linear;
+  EXPECT_NE(message(o, view).find("midpoint"), std::string::npos);
+  EXPECT_THROW(makeViewSource(VolumeView{}), InvalidInput);
+  EXPECT_THROW(parseMapping("cubic"), InvalidInput);
+}
+
+}  // namespace
