@@ -16,6 +16,7 @@
 
 #include "Image.h"
 #include "LoopExtraction.h"
+#include "FindSeed.h"
 #include "TrackComponent.h"
 
 using namespace surftrack;
@@ -44,7 +45,8 @@ void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
 
 namespace {
 
-/// A gray ball f = 100 (r - |x - c|) with noise specks, of type T.
+/// A gray ball f = 50 + 20 (r - |x - c|), with noise specks (one voxel in 50 flipped) unless
+/// `seed` is 0, of type T.
 template <class T>
 std::vector<T> noisyBall(Dims d, double r, unsigned seed) {
   std::vector<T> v(d.count());
@@ -55,7 +57,7 @@ std::vector<T> noisyBall(Dims d, double r, unsigned seed) {
         const double dist = std::sqrt((x - d.nx / 2.0) * (x - d.nx / 2.0) + (y - d.ny / 2.0) * (y - d.ny / 2.0) +
                                       (z - d.nz / 2.0) * (z - d.nz / 2.0));
         double f = std::clamp(50 + 20 * (r - dist), 0.0, 120.0);
-        if (rng() % 50 == 0) f = 120 - f;
+        if (seed && rng() % 50 == 0) f = 120 - f;
         v[(std::size_t(z) * d.ny + y) * d.nx + x] = T(f);
       }
   return v;
@@ -194,7 +196,7 @@ TEST(FrontDoor, ASeededExtractionReadsAndAllocatesOnlyNearTheSurface) {
 
 TEST(FrontDoor, FiguresMirrorsAndSeeds) {
   const Dims d{30, 30, 30};
-  const std::vector<std::uint8_t> v = noisyBall<std::uint8_t>(d, 9, 3);
+  const std::vector<std::uint8_t> v = noisyBall<std::uint8_t>(d, 9, 0);
   ExtractOptions o;
   o.selection = Selection::threshold(60.5);
   o.seed = SeedRule::fromVoxel({15, 15, 15});
@@ -261,6 +263,8 @@ TEST(FrontDoor, BadInputIsInvalidInputNamingTheValue) {
   EXPECT_NE(message(o, view).find("seed voxel (20,1,1) lies outside the image domain [0,10)x[0,10)x[0,10)"),
             std::string::npos);
   o.seed = SeedRule::fromVoxel({1, 1, 1});
+  EXPECT_NE(message(o, view).find("seed voxel (1,1,1) has no boundary surfel near it"), std::string::npos);
+  o.seed = SeedRule::ray({1, 1, 1});
   EXPECT_NE(message(o, view).find("not on any boundary"), std::string::npos);
   o.seed = SeedRule::fromSurfel(Surfel{{1, 1, 1}, 0});
   o.selection = Selection::threshold(5);
@@ -270,6 +274,73 @@ TEST(FrontDoor, BadInputIsInvalidInputNamingTheValue) {
   EXPECT_NE(message(o, view).find("midpoint"), std::string::npos);
   EXPECT_THROW(makeViewSource(VolumeView{}), InvalidInput);
   EXPECT_THROW(parseMapping("cubic"), InvalidInput);
+}
+
+}  // namespace
+
+namespace {
+
+// nearestBoundarySurfel against every boundary surfel of the image, measured one by one.
+TEST(FrontDoor, NearestSurfelSeedIsTheBruteForceNearest) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 300; ++trial) {
+    const Dims d{int(3 + rng() % 20), int(3 + rng() % 20), int(3 + rng() % 20)};
+    DenseImage<std::uint8_t> image(d, 0);
+    const int blobs = 1 + int(rng() % 3);
+    for (int b = 0; b < blobs; ++b) {
+      const Voxel c{int(rng() % d.nx), int(rng() % d.ny), int(rng() % d.nz)};
+      const int r = int(rng() % 4);
+      for (int z = 0; z < d.nz; ++z)
+        for (int y = 0; y < d.ny; ++y)
+          for (int x = 0; x < d.nx; ++x)
+            if ((x - c.x) * (x - c.x) + (y - c.y) * (y - c.y) + (z - c.z) * (z - c.z) <= r * r) image.at(x, y, z) = 1;
+    }
+    ImageGeometry g;
+    g.spacing = {0.5 + (rng() % 4) * 0.5, 1.0, 0.75};
+    const std::array<double, 3> p{double(rng() % 400) / 10 - 10, double(rng() % 400) / 10 - 10,
+                                  double(rng() % 400) / 10 - 10};
+    const ThresholdImage<std::uint8_t> binary(image, 0.5);
+    // Brute force: every (1-voxel, 0-neighbour) pair.
+    std::optional<Surfel> best;
+    double bestDistance = 0;
+    const std::array<double, 3> target = g.toPhysical(p);
+    for (int z = 0; z < d.nz; ++z)
+      for (int y = 0; y < d.ny; ++y)
+        for (int x = 0; x < d.nx; ++x)
+          for (Direction n = 0; n < 6; ++n) {
+            const Surfel s{{x, y, z}, n};
+            if (!binary(s.inside()) || binary(s.outside())) continue;
+            const Voxel c = s.inside(), o = s.outside();
+            const auto m = g.toPhysical({(c.x + o.x) / 2.0, (c.y + o.y) / 2.0, (c.z + o.z) / 2.0});
+            const double dist = std::hypot(m[0] - target[0], m[1] - target[1], m[2] - target[2]);
+            if (!best || dist < bestDistance || (dist == bestDistance && s.key() < best->key())) {
+              best = s;
+              bestDistance = dist;
+            }
+          }
+    const std::optional<NearestSurfel> found = nearestBoundarySurfel(binary, p, g);
+    ASSERT_EQ(found.has_value(), best.has_value()) << "trial " << trial;
+    if (!best) continue;
+    EXPECT_EQ(found->surfel, *best) << "trial " << trial;
+    EXPECT_DOUBLE_EQ(found->distance, bestDistance) << "trial " << trial;
+  }
+}
+
+TEST(FrontDoor, TheSpeckWarningFiresOnASpeckAndNotOnTheBall) {
+  const Dims d{40, 40, 40};
+  std::vector<std::uint8_t> v = noisyBall<std::uint8_t>(d, 12, 0);
+  v[(std::size_t(2) * d.ny + 2) * d.nx + 2] = 120;  // a one-voxel speck in a corner
+  ExtractOptions o;
+  o.selection = Selection::threshold(60.5);
+  o.seed = SeedRule::fromVoxel({1, 1, 1});
+  const Surface speck = extract(VolumeView::of(v.data(), d), o);
+  EXPECT_EQ(speck.surfels.size(), 6u);
+  ASSERT_EQ(speck.warnings.size(), 1u);
+  EXPECT_NE(speck.warnings[0].find("speck"), std::string::npos);
+  ASSERT_TRUE(speck.seed.distance);
+  EXPECT_NEAR(*speck.seed.distance, std::sqrt(0.25 + 1 + 1), 1e-12);  // to the face at x = 1.5
+  o.seed = SeedRule::fromVoxel({20, 20, 20});
+  EXPECT_TRUE(extract(VolumeView::of(v.data(), d), o).warnings.empty());
 }
 
 }  // namespace

@@ -60,7 +60,7 @@ class BinaryBrickCache {
     if (recent.key == key) return recent.brick;
     std::uint32_t b = bricks_.find(key);
     if (b == BinaryBricks::kMissing) {
-      b = bricks_.insert(binarise(key, bx, by, bz));
+      b = bricks_.insert(binariseBrick(*image_, bx, by, bz));
       if (links_.size() == links_.capacity()) reserveHugePages(links_, 2 * links_.size() + 64);
       links_.emplace_back().fill(kNoLink);
       links_.back()[13] = b;
@@ -76,22 +76,6 @@ class BinaryBrickCache {
     std::uint64_t key = kEmpty;
     std::uint32_t brick = 0;
   };
-
-  BinaryBricks::Brick binarise(std::uint64_t key, int bx, int by, int bz) const {
-    BinaryBricks::Brick b{key, {}, {}};
-    const int x0 = 8 * bx - 1, y0 = 8 * by - 1, z0 = 8 * bz - 1;
-    if constexpr (requires { image_->rows(x0, y0, z0, 10, 10, 10, &b.rows[0][0]); }) {
-      image_->rows(x0, y0, z0, 10, 10, 10, &b.rows[0][0]);
-    } else {
-      for (int z = 0; z < 10; ++z)
-        for (int y = 0; y < 10; ++y) {
-          std::uint16_t row = 0;
-          for (int x = 0; x < 10; ++x) row |= std::uint16_t((*image_)(x0 + x, y0 + y, z0 + z) << x);
-          b.rows[z][y] = row;
-        }
-    }
-    return b;
-  }
 
   const BinaryImage* image_;
   BinaryBricks bricks_;

@@ -157,4 +157,24 @@ class BinaryBricks {
   std::size_t mask_ = 0;
 };
 
+/// Brick (bx, by, bz) of `image` with its apron, binarised: through the image's block reader
+/// rows(x0, y0, z0, width, ny, nz, out) when it has one (one call per brick: dense volumes, the
+/// front door's sources), voxel by voxel otherwise.
+template <class BinaryImage>
+BinaryBricks::Brick binariseBrick(const BinaryImage& image, int bx, int by, int bz) {
+  BinaryBricks::Brick b{BinaryBricks::keyOf(bx, by, bz), {}, {}};
+  const int x0 = 8 * bx - 1, y0 = 8 * by - 1, z0 = 8 * bz - 1;
+  if constexpr (requires { image.rows(x0, y0, z0, 10, 10, 10, &b.rows[0][0]); }) {
+    image.rows(x0, y0, z0, 10, 10, 10, &b.rows[0][0]);
+  } else {
+    for (int z = 0; z < 10; ++z)
+      for (int y = 0; y < 10; ++y) {
+        std::uint16_t row = 0;
+        for (int x = 0; x < 10; ++x) row |= std::uint16_t(image(x0 + x, y0 + y, z0 + z) << x);
+        b.rows[z][y] = row;
+      }
+  }
+  return b;
+}
+
 }  // namespace surftrack

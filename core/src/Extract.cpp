@@ -35,6 +35,9 @@ Mapping parseMapping(const std::string& text) {
 
 namespace {
 
+/// A boundary of at most this many surfels is a speck (a lone voxel has 6, a 2x2x2 cube 24).
+constexpr std::size_t kSpeckSurfels = 48;
+
 std::string numberText(double v) {
   std::ostringstream s;
   s.precision(10);
@@ -91,16 +94,23 @@ class Stages {
                      " with a 0-voxel next to it: the image has no boundary surfel");
 }
 
-/// The seed rule for a voxel: a 1-voxel walks to the first 1->0 step, a 0-voxel to the first
+/// The nearest-surfel rule (FindSeed.h) for a point in index coordinates; `what` names the seed
+/// in messages.
+Surfel resolveNearestSeed(const SourceImage& binary, const std::array<double, 3>& index,
+                          const ImageGeometry& geometry, const std::string& what, SeedReport& seed) {
+  const std::optional<NearestSurfel> nearest = nearestBoundarySurfel(binary, index, geometry);
+  if (!nearest) throw InvalidInput(what + " has no boundary surfel near it: the selection is empty");
+  seed.distance = nearest->distance;
+  return nearest->surfel;
+}
+
+/// The ray rule for a voxel: a 1-voxel walks to the first 1->0 step, a 0-voxel to the first
 /// 0->1 step, along +x, then -x, +y, -y, +z, -z (seedAlongRay).
-Surfel resolveVoxelSeed(const SourceImage& binary, Voxel v, const SeedRule& rule, SeedReport& seed) {
+Surfel resolveVoxelSeed(const SourceImage& binary, Voxel v, SeedReport& seed) {
   const Dims& dims = binary.dims();
   if (!dims.contains(v)) {
     std::ostringstream msg;
     msg << "seed voxel " << v << " lies outside the image domain " << domainText(dims);
-    if (rule.kind == SeedRule::Kind::Point)
-      msg << " (the seed point (" << numberText(rule.physical[0]) << "," << numberText(rule.physical[1])
-          << "," << numberText(rule.physical[2]) << ") is outside the image)";
     throw InvalidInput(msg.str());
   }
   seed.voxel = v;
@@ -212,7 +222,21 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
         expected = size[best];
         break;
       }
-      case Kind::Voxel: seed = resolveVoxelSeed(binary, o.seed.voxel, o.seed, out.seed); break;
+      case Kind::Ray: seed = resolveVoxelSeed(binary, o.seed.voxel, out.seed); break;
+      case Kind::Voxel: {
+        const Voxel v = o.seed.voxel;
+        if (!binary.dims().contains(v)) {
+          std::ostringstream msg;
+          msg << "seed voxel " << v << " lies outside the image domain " << domainText(binary.dims());
+          throw InvalidInput(msg.str());
+        }
+        out.seed.voxel = v;
+        out.seed.voxelInside = binary(v);
+        std::ostringstream what;
+        what << "seed voxel " << v;
+        seed = resolveNearestSeed(binary, {double(v.x), double(v.y), double(v.z)}, geometry, what.str(), out.seed);
+        break;
+      }
       case Kind::Point: {
         std::array<double, 3> index;
         try {
@@ -220,9 +244,9 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
         } catch (const std::invalid_argument& e) {
           throw InvalidInput(e.what());
         }
-        Voxel v;
-        for (int a = 0; a < 3; ++a) v[a] = int(std::clamp(std::round(index[a]), -1e9, 1e9));
-        seed = resolveVoxelSeed(binary, v, o.seed, out.seed);
+        const std::string what = "seed point (" + numberText(o.seed.physical[0]) + "," +
+                                 numberText(o.seed.physical[1]) + "," + numberText(o.seed.physical[2]) + ")";
+        seed = resolveNearestSeed(binary, index, geometry, what, out.seed);
         break;
       }
       case Kind::Surfel: seed = resolveSurfelSeed(binary, o.seed.surfel); break;
@@ -260,6 +284,17 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   if (scanning) out.boundariesInImage = out.components.size();
   for (const ComponentFigures& c : out.components) out.euler += c.euler;
   stages.end();
+  // A seeded surface of a handful of voxels in a large image is most likely noise reached by
+  // the seed rule, not the object the caller meant.
+  const Dims dims = source.dims();
+  if (o.seed.kind != Kind::All && o.seed.kind != Kind::Largest && out.surfels.size() <= kSpeckSurfels &&
+      dims.count() >= 1000 * out.surfels.size()) {
+    std::ostringstream msg;
+    msg << "the surface found is a speck: " << out.surfels.size() << " surfels in a " << dims.nx << "x"
+        << dims.ny << "x" << dims.nz << " image; the seed may have reached noise (take the largest "
+        << "boundary, or a seed nearer the object)";
+    out.warnings.push_back(msg.str());
+  }
   return out;
 }
 

@@ -111,6 +111,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     return v;
   };
   if (seedKind == "voxel") o.seed = SeedRule::fromVoxel(engineVoxel(0));
+  else if (seedKind == "ray") o.seed = SeedRule::ray(engineVoxel(0));
   else if (seedKind == "surfel") {
     const Voxel c = engineVoxel(0), d = engineVoxel(3), n = d - c;
     if (std::abs(n.x) + std::abs(n.y) + std::abs(n.z) != 1)
@@ -174,7 +175,9 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     }
     out["seed_surfel"] = py::make_tuple(py::make_tuple(ci[0], ci[1], ci[2]), py::make_tuple(di[0], di[1], di[2]));
     out["seed_walk_steps"] = s.seed.walkSteps;
+    if (s.seed.distance) out["seed_distance"] = *s.seed.distance;
   }
+  out["warnings"] = s.warnings;
   return out;
 }
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from typing import Callable, Optional, Sequence
 
+import warnings as _warnings
+
 import numpy as np
 
 from . import _surftrack
@@ -33,11 +35,14 @@ class Surface:
     euler, genus  of the whole surface (sums over the components)
     boundaries_in_image  mode "largest" / "all": the boundaries the scan found
     timings   seconds per stage of the C++ core
+    seed_distance  seeded by a voxel or a point: the physical distance to the seed surfel
+    warnings  things to know, e.g. that a seeded surface is a speck (also issued as Python
+              warnings)
     """
 
     def __init__(self, vertices, faces, result=None, normals=None, surfels=None, components=(),
                  euler=0, boundaries_in_image=0, mapping="midpoint", timings=None,
-                 seed_surfel=None, seed_walk_steps=0):
+                 seed_surfel=None, seed_walk_steps=0, seed_distance=None, warnings=()):
         self.vertices = vertices
         self.faces = faces
         self._result = result
@@ -50,6 +55,8 @@ class Surface:
         self.timings = dict(timings or {})
         self.seed_surfel = seed_surfel
         self.seed_walk_steps = seed_walk_steps
+        self.seed_distance = seed_distance
+        self.warnings = list(warnings)
 
     @property
     def normals(self) -> np.ndarray:
@@ -122,15 +129,18 @@ def _range_note(array: np.ndarray, level: float) -> str:
 
 def extract(volume, *, level: Optional[float] = None, label: Optional[float] = None,
             seed: Optional[Sequence] = None, seed_point: Optional[Sequence[float]] = None,
-            mode: str = "seed", adjacency: str = "26-6", mapping: str = "default",
+            mode: str = "seed", seed_rule: str = "nearest", adjacency: str = "26-6",
+            mapping: str = "default",
             spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, affine=None,
             epsilon: float = 1e-3,
             progress: Optional[Callable[[str, int, int, int], None]] = None) -> Surface:
     """The surface of one boundary (mode="seed"), of the largest, or of all boundaries.
 
     The selected voxels are ``volume > level`` or ``volume == label``. ``seed`` is a voxel index
-    ``(i, j, k)`` (the engine walks from it along the axes to the first boundary) or a surfel
-    ``((i, j, k), (i2, j2, k2))``; ``seed_point`` is a physical point. ``mapping`` places each
+    ``(i, j, k)`` or a surfel ``((i, j, k), (i2, j2, k2))``; ``seed_point`` is a physical point.
+    A voxel or a point resolves to the boundary surfel nearest it (``seed_rule="nearest"``);
+    ``seed_rule="ray"`` walks from the voxel along +i, -i, +j, -j, +k, -k to the first boundary
+    crossed instead. ``mapping`` places each
     vertex on its surfel's segment: "linear" (iso-value interpolation, the default for a
     level), "midpoint" (the default for a label). ``progress(stage, index, stages, surfels)``
     is called at each stage and while tracking. ``affine`` (a 4x4 voxel-to-world matrix, as
@@ -163,7 +173,10 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
         else:
             s = np.asarray(seed)
             if s.shape == (3,):
-                seed_kind, seed_values[:3] = "voxel", [float(v) for v in s]
+                if seed_rule not in ("nearest", "ray"):
+                    raise ValueError(f"unknown seed_rule '{seed_rule}': expected 'nearest' or 'ray'")
+                seed_kind = "voxel" if seed_rule == "nearest" else "ray"
+                seed_values[:3] = [float(v) for v in s]
             elif s.shape == (2, 3):
                 seed_kind, seed_values = "surfel", [float(v) for v in s.reshape(-1)]
             else:
@@ -199,7 +212,10 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     except ValueError as error:
         note = _range_note(array, value) if kind == "threshold" else ""
         raise ValueError(f"{error}{note}") from None
-    return Surface(**out)
+    surface = Surface(**out)
+    for message in surface.warnings:
+        _warnings.warn(message, stacklevel=2)
+    return surface
 
 
 def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_direction="descent",

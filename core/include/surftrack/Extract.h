@@ -32,8 +32,9 @@ namespace surftrack {
 struct SeedRule {
   enum class Kind {
     Surfel,   ///< this boundary surfel
-    Voxel,    ///< walk from this voxel along +x, -x, +y, -y, +z, -z to the first surfel crossed
-    Point,    ///< the voxel nearest this physical point, then as Voxel
+    Voxel,    ///< the boundary surfel nearest this voxel's centre (its own face if it has one)
+    Point,    ///< the boundary surfel nearest this physical point
+    Ray,      ///< walk from this voxel along +x, -x, +y, -y, +z, -z to the first surfel crossed
     Largest,  ///< the boundary with the most surfels (scans the whole image)
     All       ///< every boundary of the image (scans the whole image)
   };
@@ -44,6 +45,7 @@ struct SeedRule {
 
   static SeedRule fromSurfel(const surftrack::Surfel& s) { return {Kind::Surfel, s, {}, {}}; }
   static SeedRule fromVoxel(surftrack::Voxel v) { return {Kind::Voxel, {}, v, {}}; }
+  static SeedRule ray(surftrack::Voxel v) { return {Kind::Ray, {}, v, {}}; }
   static SeedRule point(const std::array<double, 3>& p) { return {Kind::Point, {}, {}, p}; }
   static SeedRule largest() { return {Kind::Largest, {}, {}, {}}; }
   static SeedRule all() { return {Kind::All, {}, {}, {}}; }
@@ -94,10 +96,11 @@ struct ComponentFigures {
 /// What the seed rule resolved to.
 struct SeedReport {
   std::optional<surftrack::Surfel> surfel;  ///< the surfel tracking started from (seeded rules)
-  std::optional<surftrack::Voxel> voxel;    ///< Voxel / Point: the start voxel
+  std::optional<surftrack::Voxel> voxel;    ///< Voxel / Ray: the start voxel
   bool voxelInside = false;                  ///< the start voxel is a 1-voxel
-  std::optional<Direction> walkDirection;    ///< the ray that reached the surfel
-  int walkSteps = 0;                         ///< voxels walked along it
+  std::optional<double> distance;            ///< Voxel / Point: physical distance to the surfel's midpoint
+  std::optional<Direction> walkDirection;    ///< Ray: the ray that reached the surfel
+  int walkSteps = 0;                         ///< Ray: voxels walked along it
 };
 
 struct StageTime {
@@ -121,6 +124,8 @@ struct Surface {
   std::size_t boundariesInImage = 0;
 
   SeedReport seed;
+  /// Things the caller should know, one line each: e.g. that a seeded surface is a speck.
+  std::vector<std::string> warnings;
   AdjacencyPair pair = AdjacencyPair::k26_6;
   Selection selection;
   Mapping mapping = Mapping::Midpoint;  ///< the mapping used (never Default)
