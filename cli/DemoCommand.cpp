@@ -6,6 +6,8 @@
 #include <iostream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "Commands.h"
 #include "Extraction.h"
 #include "OutputFile.h"
@@ -160,22 +162,18 @@ int runDemo(const std::vector<std::string>& args) {
   }
 
   if (o.out.json) {
-    JsonWriter json;
-    json.beginObject();
-    json.key("output_dir").value(o.outputDir);
-    json.key("results").beginArray();
+    nlohmann::ordered_json json;
+    json["output_dir"] = o.outputDir;
+    json["results"] = nlohmann::ordered_json::array();
     for (const auto& r : runs) {
-      json.beginObject();
-      json.key("name").value(r.part.title);
-      json.key("command").value(r.part.command);
-      json.key("result");
-      writeJson(json, r.extraction);
-      json.endObject();
+      nlohmann::ordered_json result;
+      result["name"] = r.part.title;
+      result["command"] = r.part.command;
+      result["result"] = extractionJson(r.extraction);
+      json["results"].push_back(std::move(result));
     }
-    json.endArray();
-    json.key("notes").array(notes);
-    json.endObject();
-    std::cout << json.str() << std::endl;
+    json["notes"] = notes;
+    std::cout << jsonText(json) << std::endl;
   } else if (!o.out.quiet) {
     for (const auto& r : runs) {
       std::cout << "== " << r.part.title << "\n";

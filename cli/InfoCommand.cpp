@@ -1,6 +1,8 @@
 // `surftrack info INPUT`.
 #include <iostream>
 
+#include <nlohmann/json.hpp>
+
 #include "Commands.h"
 #include "Extraction.h"
 #include "Report.h"
@@ -13,9 +15,7 @@ int runInfo(const std::vector<std::string>& args) {
   const io::AnyVolume volume = readInput(o.input);
   const VolumeStats stats = computeStats(volume);
   if (o.out.json) {
-    JsonWriter json;
-    writeVolumeJson(json, o.input.path, volume, stats);
-    std::cout << json.str() << std::endl;
+    std::cout << jsonText(volumeJson(o.input.path, volume, stats)) << std::endl;
   } else if (!o.out.quiet) {
     printVolumeInfo(std::cout, o.input.path, volume, stats);
   }

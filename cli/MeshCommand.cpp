@@ -1,6 +1,8 @@
 // `surftrack mesh INPUT -o OUTPUT [options]`.
 #include <iostream>
 
+#include <nlohmann/json.hpp>
+
 #include "Commands.h"
 #include "Extraction.h"
 #include "OutputFile.h"
@@ -33,9 +35,7 @@ int runMesh(const std::vector<std::string>& args) {
   progress.finish();
 
   if (o.out.json) {
-    JsonWriter json;
-    writeJson(json, x);
-    std::cout << json.str() << std::endl;
+    std::cout << jsonText(extractionJson(x)) << std::endl;
   } else if (!o.out.quiet) {
     printSummary(std::cout, x);
   }

@@ -1,35 +1,48 @@
+// The command line of each subcommand, parsed with CLI11. A value that decides alone whether it
+// is valid (a number, a range, one of a set) is checked by a CLI11 validator on its option;
+// the rules between options (one seed rule, --iso or --label, the raw layout) are checked
+// after parsing. The help texts are CLI11's, laid out by HelpFormatter.
 #include "Options.h"
 
+#include <algorithm>
 #include <charconv>
+#include <climits>
 #include <cmath>
 #include <cctype>
+#include <functional>
 #include <map>
+#include <memory>
 #include <utility>
+
+#include <CLI/CLI.hpp>
 
 namespace surftrack::cli {
 
 namespace {
 
-double parseDouble(const std::string& text, const std::string& what) {
+// --- values ----------------------------------------------------------------------------------
+
+/// A finite decimal number ("nan", "inf" and hexadecimal are not).
+std::optional<double> toNumber(const std::string& text) {
   double value = 0;
   const char* end = text.data() + text.size();
   auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (ec != std::errc() || ptr != end || text.empty() || !std::isfinite(value))
-    throw UsageError(what + ": '" + text + "' is not a number");
+  if (ec != std::errc() || ptr != end || text.empty() || !std::isfinite(value)) return std::nullopt;
   return value;
 }
 
-long long parseInteger(const std::string& text, const std::string& what) {
+/// A decimal integer, with an optional sign.
+std::optional<long long> toInteger(const std::string& text) {
   long long value = 0;
   const char* begin = text.data();
   const char* end = text.data() + text.size();
   if (begin != end && *begin == '+') ++begin;
   auto [ptr, ec] = std::from_chars(begin, end, value);
-  if (ec != std::errc() || ptr != end || begin == end)
-    throw UsageError(what + ": '" + text + "' is not an integer");
+  if (ec != std::errc() || ptr != end || begin == end) return std::nullopt;
   return value;
 }
 
+/// The comma-separated parts of `text`, spaces dropped: "1, 2,3" -> {"1", "2", "3"}.
 std::vector<std::string> splitCommas(const std::string& text) {
   std::vector<std::string> parts;
   std::string cur;
@@ -45,127 +58,449 @@ std::vector<std::string> splitCommas(const std::string& text) {
   return parts;
 }
 
-std::array<double, 3> parseTriple(const std::string& text, const std::string& what) {
-  auto parts = splitCommas(text);
-  if (parts.size() != 3) throw UsageError(what + ": expected three numbers X,Y,Z, got '" + text + "'");
-  return {parseDouble(parts[0], what), parseDouble(parts[1], what), parseDouble(parts[2], what)};
+std::array<double, 3> toTriple(const std::string& text) {
+  const auto parts = splitCommas(text);
+  return {*toNumber(parts[0]), *toNumber(parts[1]), *toNumber(parts[2])};
 }
 
 std::optional<Direction> parseDirection(const std::string& text) {
-  static const std::map<std::string, Direction> names = {
-      {"+x", 0}, {"x", 0}, {"-x", 1}, {"+y", 2}, {"y", 2}, {"-y", 3}, {"+z", 4}, {"z", 4}, {"-z", 5}};
+  static const std::map<std::string, Direction> names = {{"+x", 0}, {"x", 0},  {"-x", 1}, {"+y", 2}, {"y", 2},
+                                                         {"-y", 3}, {"+z", 4}, {"z", 4},  {"-z", 5}};
   auto it = names.find(text);
   if (it == names.end()) return std::nullopt;
   return it->second;
 }
 
-/// Walks the argument list: options with a value accept "--opt VALUE" and "--opt=VALUE".
-class ArgumentReader {
- public:
-  explicit ArgumentReader(const std::vector<std::string>& args) : args_(args) {}
+// --- validators ------------------------------------------------------------------------------
+// CLI11 reports a failed check as "--option: <message>" (a ValidationError, one line).
 
-  bool next() {
-    if (i_ >= args_.size()) return false;
-    current_ = args_[i_++];
-    inlineValue_.reset();
-    if (current_.size() > 2 && current_.rfind("--", 0) == 0) {
-      auto eq = current_.find('=');
-      if (eq != std::string::npos) {
-        inlineValue_ = current_.substr(eq + 1);
-        current_ = current_.substr(0, eq);
+const CLI::Validator kNumber(
+    [](std::string& s) { return toNumber(s) ? std::string() : "'" + s + "' is not a number"; }, "NUMBER");
+
+/// A transform: checks a decimal integer and writes it without sign or leading zeros, so that
+/// CLI11's own conversions (which read "010" as octal) see the value we see.
+const CLI::Validator kInteger(
+    [](std::string& s) {
+      const auto v = toInteger(s);
+      if (!v) return "'" + s + "' is not an integer";
+      s = std::to_string(*v);
+      return std::string();
+    },
+    "INTEGER");
+
+/// `check`, a CLI11 validator, with the tool's own message when it fails.
+CLI::Validator explained(const CLI::Validator& check,
+                         std::function<std::string(const std::string&)> message) {
+  return CLI::Validator(
+      [check, message](std::string& s) { return check(s).empty() ? std::string() : message(s); },
+      check.get_description());
+}
+CLI::Validator explained(const CLI::Validator& check, const std::string& message) {
+  return explained(check, [message](const std::string&) { return message; });
+}
+
+/// A validator calling a parser of the library, which throws std::invalid_argument.
+template <class Parse>
+CLI::Validator parsedBy(Parse parse, const std::string& description) {
+  return CLI::Validator(
+      [parse](std::string& s) {
+        try {
+          parse(s);
+        } catch (const std::invalid_argument& e) {
+          return std::string(e.what());
+        }
+        return std::string();
+      },
+      description);
+}
+
+/// Three comma-separated values, each passing every validator of `element`.
+CLI::Validator tripleOf(std::vector<CLI::Validator> element, const std::string& countMessage) {
+  return CLI::Validator(
+      [element, countMessage](std::string& s) {
+        auto parts = splitCommas(s);
+        if (parts.size() != 3) return countMessage + ", got '" + s + "'";
+        for (std::string& part : parts)
+          for (const CLI::Validator& check : element) {
+            const std::string error = check(part);
+            if (!error.empty()) return error;
+          }
+        return std::string();
+      },
+      "X,Y,Z");
+}
+
+const CLI::Validator kSeedCoordinate = explained(CLI::Range(-(1 << 20), 1 << 20), "coordinate out of range");
+
+/// --seed: a voxel x,y,z or a surfel x,y,z,DIR.
+const CLI::Validator kSeed(
+    [](std::string& s) {
+      const auto parts = splitCommas(s);
+      if (parts.size() != 3 && parts.size() != 4)
+        return "expected a voxel x,y,z or a surfel x,y,z,DIR (DIR one of +x -x +y -y +z -z), got '" + s + "'";
+      for (int a = 0; a < 3; ++a) {
+        std::string c = parts[a];
+        std::string error = kInteger(c);
+        if (error.empty()) error = kSeedCoordinate(c);
+        if (!error.empty()) return error;
       }
+      if (parts.size() == 4 && !parseDirection(parts[3]))
+        return "'" + parts[3] + "' is not a direction (+x -x +y -y +z -z)";
+      return std::string();
+    },
+    "x,y,z[,DIR]");
+
+// --- help ------------------------------------------------------------------------------------
+
+/// The help layout: "usage: <usage>", the description, then each group of options (with the
+/// positionals) under its heading, the commands, the footer.
+class HelpFormatter : public CLI::Formatter {
+ public:
+  explicit HelpFormatter(std::string usage) : usage_(std::move(usage)) { column_width(23); }
+
+  std::string make_usage(const CLI::App*, std::string) const override { return "usage: " + usage_ + "\n"; }
+
+  std::string make_group(std::string group, bool, std::vector<const CLI::Option*> opts) const override {
+    std::string out = group + ":\n";
+    for (const CLI::Option* opt : opts) out += make_option(opt, opt->get_positional());
+    return out;
+  }
+
+  std::string make_help(const CLI::App* app, std::string name, CLI::AppFormatMode) const override {
+    std::string out = make_usage(app, name);
+    if (!app->get_description().empty()) out += "\n" + app->get_description() + "\n";
+    const auto commands = app->get_subcommands({});
+    if (!commands.empty()) {
+      out += "\ncommands:\n";
+      for (const CLI::App* command : commands) out += make_subcommand(command);
     }
-    return true;
-  }
-  const std::string& name() const { return current_; }
-  bool isOption() const { return current_.size() > 1 && current_[0] == '-' && !looksNumeric(current_); }
-  std::string value() {
-    if (inlineValue_) return *std::exchange(inlineValue_, std::nullopt);
-    if (i_ >= args_.size()) throw UsageError("option " + current_ + " needs a value");
-    return args_[i_++];
-  }
-  void noValue() const {
-    if (inlineValue_) throw UsageError("option " + current_ + " takes no value");
+    bool first = true;
+    for (const std::string& group : app->get_groups()) {
+      const auto opts = app->get_options([&](const CLI::Option* o) { return o->get_group() == group; });
+      if (group.empty() || opts.empty()) continue;
+      out += (first && commands.empty() ? "\n" : "") + make_group(group, false, opts);
+      first = false;
+    }
+    if (!app->get_footer().empty()) out += "\n" + app->get_footer() + "\n";
+    return out;
   }
 
  private:
-  static bool looksNumeric(const std::string& s) {
-    return s.size() > 1 && s[0] == '-' && (std::isdigit(static_cast<unsigned char>(s[1])) || s[1] == '.');
-  }
-  const std::vector<std::string>& args_;
-  std::size_t i_ = 0;
-  std::string current_;
-  std::optional<std::string> inlineValue_;
+  std::string usage_;
 };
 
-/// Which raw-layout options were given, to check they come together.
-struct RawFlags {
-  bool type = false;   ///< --raw-type
-  bool other = false;  ///< --raw-endian, --raw-header
+void setUsage(CLI::App& app, const std::string& usage) {
+  app.formatter(std::make_shared<HelpFormatter>(usage));
+}
+
+/// Common settings: an option given twice keeps its last value (as in most tools), a flag
+/// takes no value, an unknown argument is collected (rejectExtras names it).
+void configure(CLI::App& app) {
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.option_defaults()->disable_flag_override();
+  app.allow_extras();
+}
+
+/// The help flag, last in the "output" group.
+void addHelp(CLI::App& app) { app.set_help_flag("-h,--help", "print this help and exit")->group("output"); }
+
+CLI::Option* addValue(CLI::App& app, const std::string& names, const std::string& valueName,
+                      std::function<void(const std::string&)> set, const std::string& description) {
+  return app.add_option_function<std::string>(names, std::move(set), description)->option_text(valueName);
+}
+
+// --- options shared by the commands ----------------------------------------------------------
+
+/// The options every command reading a volume accepts.
+struct InputArgs {
+  CLI::Option* dims = nullptr;
+  CLI::Option* type = nullptr;
+  CLI::Option* endian = nullptr;
+  CLI::Option* header = nullptr;
 };
 
-/// Options every command reading a volume accepts; returns false if `name` is not one.
-bool parseInputOption(ArgumentReader& r, InputOptions& in, RawFlags& flags) {
-  const std::string& n = r.name();
-  if (n == "--raw-type") flags.type = true;
-  if (n == "--raw-endian" || n == "--raw-header") flags.other = true;
-  if (n == "--raw-dims") {
-    auto parts = splitCommas(r.value());
-    if (parts.size() != 3) throw UsageError("--raw-dims: expected NX,NY,NZ");
-    int d[3];
-    for (int a = 0; a < 3; ++a) {
-      long long v = parseInteger(parts[a], "--raw-dims");
-      if (v <= 0 || v > (1 << 19) - 3) throw UsageError("--raw-dims: dimensions must be in [1, 524285]");
-      d[a] = int(v);
-    }
-    in.raw = true;
-    in.rawLayout.dims = Dims{d[0], d[1], d[2]};
-  } else if (n == "--raw-type") {
-    try {
-      in.rawLayout.type = io::parseScalarType(r.value());
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("--raw-type: ") + e.what());
-    }
-  } else if (n == "--raw-endian") {
-    std::string v = r.value();
-    if (v == "little") in.rawLayout.bigEndian = false;
-    else if (v == "big") in.rawLayout.bigEndian = true;
-    else throw UsageError("--raw-endian: expected little or big, got '" + v + "'");
-  } else if (n == "--raw-header") {
-    long long v = parseInteger(r.value(), "--raw-header");
-    if (v < 0) throw UsageError("--raw-header: must not be negative");
-    in.rawLayout.headerBytes = std::size_t(v);
-  } else if (n == "--spacing") {
-    auto s = parseTriple(r.value(), "--spacing");
-    for (double v : s)
-      if (!(v > 0)) throw UsageError("--spacing: every spacing must be positive");
-    in.spacing = s;
-  } else if (n == "--origin") {
-    in.origin = parseTriple(r.value(), "--origin");
-  } else {
-    return false;
-  }
-  return true;
+constexpr long long kMaxDim = (1 << 19) - 3;
+
+InputArgs addInputOptions(CLI::App& app, InputOptions& in) {
+  InputArgs a;
+  a.dims = addValue(
+               app, "--raw-dims", "NX,NY,NZ",
+               [&in](const std::string& s) {
+                 const auto parts = splitCommas(s);
+                 in.raw = true;
+                 in.rawLayout.dims =
+                     Dims{int(*toInteger(parts[0])), int(*toInteger(parts[1])), int(*toInteger(parts[2]))};
+               },
+               "the size of a headerless raw file (x fastest, then y, then z)")
+               ->check(tripleOf(
+                   {kInteger, explained(CLI::Range(1LL, kMaxDim), "dimensions must be in [1, 524285]")},
+                   "expected NX,NY,NZ"))
+               ->group("raw input");
+  a.type =
+      addValue(
+          app, "--raw-type", "T", [&in](const std::string& s) { in.rawLayout.type = io::parseScalarType(s); },
+          "its voxel type: uint8, int8, uint16, int16, uint32, int32, uint64, int64,\nfloat or double")
+          ->check(parsedBy([](const std::string& s) { io::parseScalarType(s); }, "TYPE"))
+          ->group("raw input");
+  a.endian =
+      addValue(
+          app, "--raw-endian", "ORDER", [&in](const std::string& s) { in.rawLayout.bigEndian = s == "big"; },
+          "its byte order: little (default) or big")
+          ->check(explained(CLI::IsMember({"little", "big"}),
+                            [](const std::string& s) { return "expected little or big, got '" + s + "'"; }))
+          ->group("raw input");
+  a.header =
+      app.add_option("--raw-header", in.rawLayout.headerBytes, "bytes to skip at its start (default: 0)")
+          ->option_text("BYTES")
+          ->transform(kInteger)
+          ->check(explained(CLI::Range(0LL, LLONG_MAX), "must not be negative"))
+          ->group("raw input");
+  addValue(
+      app, "--spacing", "SX,SY,SZ", [&in](const std::string& s) { in.spacing = toTriple(s); },
+      "the voxel spacing, instead of the file's")
+      ->check(tripleOf({kNumber, explained(CLI::PositiveNumber, "every spacing must be positive")},
+                       "expected three numbers X,Y,Z"))
+      ->group("geometry override");
+  addValue(
+      app, "--origin", "OX,OY,OZ", [&in](const std::string& s) { in.origin = toTriple(s); },
+      "the physical position of voxel (0,0,0), instead of the file's")
+      ->check(tripleOf({kNumber}, "expected three numbers X,Y,Z"))
+      ->group("geometry override");
+  return a;
 }
 
-bool parseOutputOption(ArgumentReader& r, OutputOptions& out) {
-  if (r.name() == "--json") {
-    r.noValue();
-    out.json = true;
-  } else if (r.name() == "--quiet" || r.name() == "-q") {
-    r.noValue();
-    out.quiet = true;
-  } else {
-    return false;
-  }
-  return true;
+void addOutputOptions(CLI::App& app, OutputOptions& out) {
+  app.add_flag("--json", out.json, "a JSON object on stdout instead of the summary")->group("output");
+  app.add_flag("-q,--quiet", out.quiet, "print nothing but errors")->group("output");
 }
 
-void checkRaw(const InputOptions& in, const RawFlags& flags) {
-  if ((flags.type || flags.other) && !in.raw)
+void addInput(CLI::App& app, InputOptions& in) {
+  app.add_option("INPUT", in.path,
+                 ".nii .nii.gz .nrrd .nhdr .mha .mhd .dcm .tif .vtk, a directory with\n"
+                 "one DICOM series, or a raw file with --raw-dims and --raw-type")
+      ->type_name("")
+      ->group("input and output");
+}
+
+void checkRaw(const InputOptions& in, const InputArgs& a) {
+  const bool type = a.type->count() > 0, other = a.endian->count() > 0 || a.header->count() > 0;
+  if ((type || other) && !in.raw)
     throw UsageError("--raw-type, --raw-endian and --raw-header need --raw-dims");
-  if (in.raw && !flags.type)
-    throw UsageError("a raw file needs --raw-type (uint8, int16, uint16, int32, float or double)");
+  if (in.raw && !type)
+    throw UsageError(
+        "a raw file needs --raw-type (uint8, int8, uint16, int16, uint32, int32, uint64, int64, float or "
+        "double)");
+}
+
+// --- parsing ---------------------------------------------------------------------------------
+
+std::string oneLine(std::string message) {
+  for (char& ch : message)
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  return message;
+}
+
+void parse(CLI::App& app, const std::vector<std::string>& args) {
+  std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
+  try {
+    app.parse(reversed);
+  } catch (const CLI::CallForHelp&) {
+    throw HelpRequested{app.help()};
+  } catch (const CLI::ArgumentMismatch& e) {
+    // Said as the tool always said it: a value given to a flag ("--json=1", which CLI11 reports
+    // with the flag's name without dashes), no value after an option (CLI11: "--iso: 1
+    // required TEXT missing").
+    const std::string what = e.what();
+    const auto endsWith = [&](const std::string& suffix) {
+      return what.size() > suffix.size() &&
+             what.compare(what.size() - suffix.size(), suffix.size(), suffix) == 0;
+    };
+    const std::string flagValue = " was given a disallowed flag override";
+    if (endsWith(flagValue))
+      throw UsageError("option --" + what.substr(0, what.size() - flagValue.size()) + " takes no value");
+    const std::size_t colon = what.find(": ");
+    if (endsWith(" missing") && colon != std::string::npos &&
+        what.find(" required ", colon) != std::string::npos)
+      throw UsageError("option " + what.substr(0, colon) + " needs a value");
+    throw UsageError(oneLine(what));
+  } catch (const CLI::ParseError& e) {
+    throw UsageError(oneLine(e.what()));
+  }
+}
+
+bool looksLikeOption(const std::string& s) {
+  const bool numeric =
+      s.size() > 1 && s[0] == '-' && (std::isdigit(static_cast<unsigned char>(s[1])) || s[1] == '.');
+  return s.size() > 1 && s[0] == '-' && !numeric;
+}
+
+/// The first argument CLI11 did not take: an unknown option, or a second input volume (CLI11
+/// also leaves there a "--" after which no positional was expected).
+void rejectExtras(const CLI::App& app, const std::string& command) {
+  bool afterMark = false;
+  for (const std::string& arg : app.remaining()) {
+    if (arg == "--" && !afterMark) {
+      afterMark = true;
+      continue;
+    }
+    if (!afterMark && looksLikeOption(arg))
+      throw UsageError("unknown option '" + (arg.rfind("--", 0) == 0 ? arg.substr(0, arg.find('=')) : arg) +
+                       "' for 'surftrack " + command + "'");
+    throw UsageError("unexpected argument '" + arg + "' (one input volume only)");
+  }
+}
+
+// --- the commands ----------------------------------------------------------------------------
+
+const char* const kMeshSummary = "extract a surface and write it as a mesh";
+const char* const kInfoSummary = "describe a volume: size, type, geometry, values";
+const char* const kDemoSummary =
+    "extract surfaces of a built-in phantom (and of the\nmricron-data MRI volumes when installed)";
+
+struct MeshArgs {
+  InputArgs input;
+  std::vector<const CLI::Option*> seedRules;  ///< --seed, --seed-point, --largest, --all
+  CLI::Option* largest = nullptr;
+  CLI::Option* all = nullptr;
+  CLI::Option* mapping = nullptr;
+};
+
+MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
+  configure(app);
+  setUsage(app, "surftrack mesh INPUT -o OUTPUT [options]");
+  app.description(
+      "Tracks one boundary between the 1-voxels and the 0-voxels of INPUT and writes it as a\n"
+      "closed triangle mesh.");
+  MeshArgs a;
+  addInput(app, o.input);
+  app.add_option("-o,--output", o.output,
+                 ".ply (binary unless --ascii), .obj, .off, .stl; vertices in physical\ncoordinates")
+      ->option_text("OUTPUT")
+      ->group("input and output");
+
+  addValue(
+      app, "--iso", "S", [&o](const std::string& s) { o.surface.iso = toNumber(s); },
+      "voxels with value > S (default: Otsu's threshold of the histogram)")
+      ->check(kNumber)
+      ->group("what is inside (1-voxels)");
+  addValue(
+      app, "--label", "L", [&o](const std::string& s) { o.surface.label = toNumber(s); },
+      "voxels with value = L")
+      ->check(kNumber)
+      ->group("what is inside (1-voxels)");
+
+  const std::string which = "which surface (one of)";
+  a.largest =
+      app.add_flag("--largest")->description("the boundary with the most surfels (default)")->group(which);
+  a.all = app.add_flag("--all")->description("every boundary, in one mesh")->group(which);
+  CLI::Option* seed = addValue(
+                          app, "--seed", "x,y,z[,DIR]",
+                          [&o](const std::string& s) {
+                            const auto parts = splitCommas(s);
+                            o.surface.seedVoxel = Voxel{int(*toInteger(parts[0])), int(*toInteger(parts[1])),
+                                                        int(*toInteger(parts[2]))};
+                            o.surface.seedMode = SeedMode::Voxel;
+                            if (parts.size() == 4) {
+                              o.surface.seedMode = SeedMode::Surfel;
+                              o.surface.seedDirection = *parseDirection(parts[3]);
+                            }
+                          },
+                          "voxel x,y,z: the boundary first met walking from it along +x (then -x,\n"
+                          "+y, -y, +z, -z); the surfel used is printed. x,y,z,DIR: the boundary of\n"
+                          "surfel (c=(x,y,z), d=c+DIR), DIR one of +x -x +y -y +z -z")
+                          ->check(kSeed)
+                          ->group(which);
+  CLI::Option* seedPoint = addValue(
+                               app, "--seed-point", "X,Y,Z",
+                               [&o](const std::string& s) {
+                                 o.surface.seedPoint = toTriple(s);
+                                 o.surface.seedMode = SeedMode::Point;
+                               },
+                               "like --seed x,y,z, from the voxel nearest to a physical point")
+                               ->check(tripleOf({kNumber}, "expected three numbers X,Y,Z"))
+                               ->group(which);
+  a.seedRules = {seed, seedPoint, a.largest, a.all};
+
+  addValue(
+      app, "-a,--adjacency", "K-L", [&o](const std::string& s) { o.surface.pair = parseAdjacencyPair(s); },
+      "26-6 (default), 18-6, 6-18 or 6-26: adjacency of inside-outside voxels")
+      ->check(parsedBy([](const std::string& s) { parseAdjacencyPair(s); }, "K-L"))
+      ->group("surface options");
+  a.mapping = app.add_option("--mapping", mapping,
+                             "linear (default with --iso: vertices at the interpolated iso-value)\n"
+                             "or midpoint (vertices halfway between the two voxels)")
+                  ->option_text("M")
+                  ->transform(CLI::Transformer(std::map<std::string, std::string>{{"iso", "linear"}}))
+                  ->check(explained(
+                      CLI::IsMember({"midpoint", "linear"}),
+                      [](const std::string& s) { return "expected midpoint or linear, got '" + s + "'"; }))
+                  ->group("surface options");
+  app.add_flag("--ascii", o.ascii, "text PLY / STL")->group("surface options");
+
+  a.input = addInputOptions(app, o.input);
+  addOutputOptions(app, o.out);
+  addHelp(app);
+  return a;
+}
+
+void defineInfo(CLI::App& app, InfoOptions& o, InputArgs& a) {
+  configure(app);
+  setUsage(app, "surftrack info INPUT [options]");
+  app.description(
+      "Prints the size, voxel type, spacing, origin, direction, value range, a histogram summary,\n"
+      "Otsu's threshold (the default --iso of 'surftrack mesh') and, for integer images with few\n"
+      "values, the labels present.");
+  addInput(app, o.input);
+  a = addInputOptions(app, o.input);
+  addOutputOptions(app, o.out);
+  addHelp(app);
+}
+
+void defineDemo(CLI::App& app, DemoOptions& o) {
+  configure(app);
+  setUsage(app, "surftrack demo [options]");
+  app.description(
+      "Builds a phantom (a sphere minus three orthogonal cylinders, Q^3 voxels, with P salt-and-\n"
+      "pepper noise), tracks the surface of its seed and writes DIR/phantom.nrrd and DIR/phantom.ply.\n"
+      "With the Debian package mricron-data installed, it also extracts the cortical surface of\n"
+      "ch2better.nii.gz and one label of the aal.nii.gz atlas.");
+  const std::string group = "options";
+  app.add_option("-o,--output", o.outputDir, "the output directory (default: surftrack-demo)")
+      ->option_text("DIR")
+      ->group(group);
+  app.add_option("--size", o.size, "the phantom side, 16 to 1024 (default: 128)")
+      ->option_text("Q")
+      ->transform(kInteger)
+      ->check(explained(CLI::Range(16, 1024), "the phantom side must be in [16, 1024]"))
+      ->group(group);
+  addValue(
+      app, "--noise", "P", [&o](const std::string& s) { o.noise = *toNumber(s); },
+      "the salt-and-pepper noise probability, 0 to 0.5 (default: 0.01)")
+      ->check(kNumber)
+      ->check(explained(CLI::Range(0.0, 0.5), "the noise probability must be in [0, 0.5]"))
+      ->group(group);
+  app.add_flag_callback(
+         "--no-mricron", [&o] { o.realData = false; }, "skip the MRI part")
+      ->group(group);
+  app.add_option("--mricron-dir", o.mricronDir,
+                 "where mricron-data's volumes are\n(default: " + o.mricronDir + ")")
+      ->option_text("DIR")
+      ->group(group);
+  addOutputOptions(app, o.out);
+  addHelp(app);
+}
+
+void defineMain(CLI::App& app) {
+  setUsage(app, "surftrack COMMAND [ARGS]");
+  app.description(
+      "Extracts ONE connected iso-surface from a 3D image by tracking its digital boundary\n"
+      "(Lachaud & Montanvert, \"Continuous analogs of digital boundaries\").");
+  app.add_subcommand("mesh", kMeshSummary);
+  app.add_subcommand("info", kInfoSummary);
+  app.add_subcommand("demo", kDemoSummary);
+  app.add_flag("--version")->description("print the version and exit")->group("options");
+  app.set_help_flag("-h,--help", "print this help and exit")->group("options");
+  app.footer("Run 'surftrack COMMAND --help' for the options of a command.");
 }
 
 }  // namespace
@@ -177,198 +512,84 @@ std::string directionName(Direction d) {
 
 MeshOptions parseMeshOptions(const std::vector<std::string>& args) {
   MeshOptions o;
-  ArgumentReader r(args);
-  RawFlags raw;
-  int seedOptions = 0;
-  std::string seedGiven;
-  auto setSeed = [&](SeedMode mode) {
-    if (++seedOptions > 1)
-      throw UsageError("give only one of --seed, --seed-point, --largest, --all (got " + seedGiven +
-                       " and " + r.name() + ")");
-    seedGiven = r.name();
-    o.surface.seedMode = mode;
-  };
-  while (r.next()) {
-    const std::string n = r.name();
-    if (!r.isOption()) {
-      if (!o.input.path.empty()) throw UsageError("unexpected argument '" + n + "' (one input volume only)");
-      o.input.path = n;
-    } else if (n == "-o" || n == "--output") {
-      o.output = r.value();
-    } else if (n == "--iso") {
-      o.surface.iso = parseDouble(r.value(), "--iso");
-    } else if (n == "--label") {
-      o.surface.label = parseDouble(r.value(), "--label");
-    } else if (n == "--seed") {
-      setSeed(SeedMode::Voxel);
-      const std::string v = r.value();
-      auto parts = splitCommas(v);
-      if (parts.size() != 3 && parts.size() != 4)
-        throw UsageError("--seed: expected a voxel x,y,z or a surfel x,y,z,DIR (DIR one of +x -x +y -y +z -z), got '" + v + "'");
-      for (int a = 0; a < 3; ++a) {
-        long long c = parseInteger(parts[a], "--seed");
-        if (c < -(1 << 20) || c > (1 << 20)) throw UsageError("--seed: coordinate out of range");
-        o.surface.seedVoxel[a] = int(c);
-      }
-      if (parts.size() == 4) {
-        auto d = parseDirection(parts[3]);
-        if (!d) throw UsageError("--seed: '" + parts[3] + "' is not a direction (+x -x +y -y +z -z)");
-        o.surface.seedMode = SeedMode::Surfel;
-        o.surface.seedDirection = *d;
-      }
-    } else if (n == "--seed-point") {
-      setSeed(SeedMode::Point);
-      o.surface.seedPoint = parseTriple(r.value(), "--seed-point");
-    } else if (n == "--largest") {
-      r.noValue();
-      setSeed(SeedMode::Largest);
-    } else if (n == "--all") {
-      r.noValue();
-      setSeed(SeedMode::All);
-    } else if (n == "--adjacency" || n == "-a") {
-      try {
-        o.surface.pair = parseAdjacencyPair(r.value());
-      } catch (const std::invalid_argument& e) {
-        throw UsageError(std::string("--adjacency: ") + e.what());
-      }
-    } else if (n == "--mapping") {
-      const std::string v = r.value();
-      if (v == "midpoint") o.surface.mapping = MappingMode::Midpoint;
-      else if (v == "linear" || v == "iso") o.surface.mapping = MappingMode::Linear;
-      else throw UsageError("--mapping: expected midpoint or linear, got '" + v + "'");
-    } else if (n == "--ascii") {
-      r.noValue();
-      o.ascii = true;
-    } else if (n == "-h" || n == "--help") {
-      throw HelpRequested{meshUsage()};
-    } else if (!parseInputOption(r, o.input, raw) && !parseOutputOption(r, o.out)) {
-      throw UsageError("unknown option '" + n + "' for 'surftrack mesh'");
-    }
-  }
+  std::string mapping;
+  CLI::App app;
+  const MeshArgs a = defineMesh(app, o, mapping);
+  parse(app, args);
+  rejectExtras(app, "mesh");
+
+  std::vector<std::string> rules;
+  for (const CLI::Option* opt : app.parse_order())
+    if (std::find(a.seedRules.begin(), a.seedRules.end(), opt) != a.seedRules.end())
+      rules.push_back(opt->get_name());
+  if (rules.size() > 1)
+    throw UsageError("give only one of --seed, --seed-point, --largest, --all (got " + rules[0] + " and " +
+                     rules[1] + ")");
+  if (a.largest->count()) o.surface.seedMode = SeedMode::Largest;
+  if (a.all->count()) o.surface.seedMode = SeedMode::All;
+  if (a.mapping->count())
+    o.surface.mapping = mapping == "midpoint" ? MappingMode::Midpoint : MappingMode::Linear;
+
   if (o.input.path.empty()) throw UsageError("missing the input volume: surftrack mesh INPUT -o OUTPUT");
   if (o.output.empty()) throw UsageError("missing the output mesh: -o OUTPUT (.ply, .obj, .off or .stl)");
   if (o.surface.iso && o.surface.label) throw UsageError("give --iso or --label, not both");
   if (o.surface.label && o.surface.mapping == MappingMode::Linear)
     throw UsageError("--mapping linear interpolates an iso-value: it needs --iso, not --label");
-  checkRaw(o.input, raw);
+  checkRaw(o.input, a.input);
   return o;
 }
 
 InfoOptions parseInfoOptions(const std::vector<std::string>& args) {
   InfoOptions o;
-  ArgumentReader r(args);
-  RawFlags raw;
-  while (r.next()) {
-    const std::string n = r.name();
-    if (!r.isOption()) {
-      if (!o.input.path.empty()) throw UsageError("unexpected argument '" + n + "' (one input volume only)");
-      o.input.path = n;
-    } else if (n == "-h" || n == "--help") {
-      throw HelpRequested{infoUsage()};
-    } else if (!parseInputOption(r, o.input, raw) && !parseOutputOption(r, o.out)) {
-      throw UsageError("unknown option '" + n + "' for 'surftrack info'");
-    }
-  }
+  InputArgs a;
+  CLI::App app;
+  defineInfo(app, o, a);
+  parse(app, args);
+  rejectExtras(app, "info");
   if (o.input.path.empty()) throw UsageError("missing the input volume: surftrack info INPUT");
-  checkRaw(o.input, raw);
+  checkRaw(o.input, a);
   return o;
 }
 
 DemoOptions parseDemoOptions(const std::vector<std::string>& args) {
   DemoOptions o;
-  ArgumentReader r(args);
-  while (r.next()) {
-    const std::string n = r.name();
-    if (n == "-o" || n == "--output") {
-      o.outputDir = r.value();
-    } else if (n == "--size") {
-      long long q = parseInteger(r.value(), "--size");
-      if (q < 16 || q > 1024) throw UsageError("--size: the phantom side must be in [16, 1024]");
-      o.size = int(q);
-    } else if (n == "--noise") {
-      double p = parseDouble(r.value(), "--noise");
-      if (p < 0 || p > 0.5) throw UsageError("--noise: the noise probability must be in [0, 0.5]");
-      o.noise = p;
-    } else if (n == "--no-mricron") {
-      r.noValue();
-      o.realData = false;
-    } else if (n == "--mricron-dir") {
-      o.mricronDir = r.value();
-    } else if (n == "-h" || n == "--help") {
-      throw HelpRequested{demoUsage()};
-    } else if (!parseOutputOption(r, o.out)) {
-      throw UsageError("unknown argument '" + n + "' for 'surftrack demo'");
-    }
-  }
+  CLI::App app;
+  defineDemo(app, o);
+  parse(app, args);
+  for (const std::string& arg : app.remaining())
+    if (arg != "--")
+      throw UsageError("unknown argument '" + (arg.rfind("--", 0) == 0 ? arg.substr(0, arg.find('=')) : arg) +
+                       "' for 'surftrack demo'");
   return o;
 }
 
 std::string mainUsage() {
-  return R"(usage: surftrack COMMAND [ARGS]
-
-Extracts ONE connected iso-surface from a 3D image by tracking its digital boundary
-(Lachaud & Montanvert, "Continuous analogs of digital boundaries").
-
-commands:
-  mesh INPUT -o OUTPUT [options]   extract a surface and write it as a mesh
-  info INPUT [options]             describe a volume: size, type, geometry, values
-  demo [-o DIR]                    extract surfaces of a built-in phantom (and of the
-                                   mricron-data MRI volumes when installed)
-
-Run 'surftrack COMMAND --help' for the options of a command.
-)";
+  CLI::App app;
+  defineMain(app);
+  return app.help();
 }
 
 std::string meshUsage() {
-  return R"(usage: surftrack mesh INPUT -o OUTPUT [options]
-
-INPUT   .nii .nii.gz .nrrd .nhdr .mha .mhd .dcm .tif .vtk, a directory with one DICOM
-        series, or a raw file with --raw-dims and --raw-type
-OUTPUT  .ply (binary unless --ascii), .obj, .off, .stl; vertices in physical coordinates
-
-what is inside (1-voxels):
-  --iso S              voxels with value > S (default: Otsu's threshold of the histogram)
-  --label L            voxels with value = L
-which surface:
-  --largest            the boundary with the most surfels (default)
-  --all                every boundary, in one mesh
-  --seed x,y,z         the boundary first met walking from voxel (x,y,z) along +x
-                       (then -x, +y, -y, +z, -z); the surfel used is printed
-  --seed x,y,z,DIR     the boundary of surfel (c=(x,y,z), normal DIR in +x -x +y -y +z -z)
-  --seed-point X,Y,Z   like --seed, from the voxel nearest to a physical point
-surface options:
-  --adjacency K-L      26-6 (default), 18-6, 6-18 or 6-26: adjacency of inside-outside voxels
-  --mapping M          linear (default with --iso: vertices at the interpolated iso-value)
-                       or midpoint (vertices halfway between the two voxels)
-  --ascii              text PLY / STL
-raw input:
-  --raw-dims NX,NY,NZ  --raw-type uint8|int16|uint16|int32|float|double
-  --raw-endian little|big   --raw-header BYTES
-geometry override:
-  --spacing SX,SY,SZ   --origin OX,OY,OZ
-output:
-  --json               a JSON object on stdout instead of the summary
-  --quiet, -q          print nothing but errors
-)";
+  MeshOptions o;
+  std::string mapping;
+  CLI::App app;
+  defineMesh(app, o, mapping);
+  return app.help();
 }
 
 std::string infoUsage() {
-  return R"(usage: surftrack info INPUT [--json] [--raw-dims NX,NY,NZ --raw-type T ...]
-
-Prints the size, voxel type, spacing, origin, direction, value range, a histogram summary,
-Otsu's threshold (the default --iso of 'surftrack mesh') and, for integer images with few
-values, the labels present.
-)";
+  InfoOptions o;
+  InputArgs a;
+  CLI::App app;
+  defineInfo(app, o, a);
+  return app.help();
 }
 
 std::string demoUsage() {
-  return R"(usage: surftrack demo [-o DIR] [--size Q] [--noise P] [--no-mricron] [--json] [--quiet]
-
-Builds a phantom (a sphere minus three orthogonal cylinders, Q^3 voxels, Q = 128, with
-P = 1 % salt-and-pepper noise), tracks the surface of its seed and writes DIR/phantom.nrrd and
-DIR/phantom.ply (DIR = surftrack-demo). With the Debian package mricron-data installed, it
-also extracts the cortical surface of ch2better.nii.gz and one label of the aal.nii.gz atlas.
-)";
+  DemoOptions o;
+  CLI::App app;
+  defineDemo(app, o);
+  return app.help();
 }
 
 }  // namespace surftrack::cli

@@ -1,13 +1,18 @@
 #include "Report.h"
 
 #include <cmath>
+#include <cstdint>
 #include <iomanip>
 #include <map>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 namespace surftrack::cli {
 
 namespace {
+
+using json = nlohmann::ordered_json;
 
 std::string num(double v, int precision = 6) {
   std::ostringstream s;
@@ -103,6 +108,24 @@ std::string seedText(const Extraction& x) {
   return s.str();
 }
 
+/// A number for JSON: an integer when the value is one (as people write it: 2, not 2.0), null
+/// when it is not finite (JSON has no NaN or infinity).
+json number(double v) {
+  if (!std::isfinite(v)) return nullptr;
+  if (v == std::floor(v) && std::abs(v) < 1e15) return static_cast<std::int64_t>(v);
+  return v;
+}
+
+json numbers(const std::array<double, 3>& p) { return {number(p[0]), number(p[1]), number(p[2])}; }
+
+json voxelJson(Voxel v) { return {v.x, v.y, v.z}; }
+
+json directionJson(const ImageGeometry& g) {
+  json rows = json::array();
+  for (const auto& r : g.direction) rows.push_back(numbers(r));
+  return rows;
+}
+
 std::string genusText(double g) {
   if (g == std::floor(g)) return num(g);
   return num(g) + " (not an integer: the surface is not closed and orientable)";
@@ -174,100 +197,79 @@ void printSummary(std::ostream& out, const Extraction& x) {
   }
 }
 
-void writeJson(JsonWriter& j, const Extraction& x) {
+json extractionJson(const Extraction& x) {
   const MeshStats& m = x.stats;
-  auto triple = [&](const std::array<double, 3>& p) { j.array(p); };
-  auto voxel = [&](Voxel v) { j.array(std::array<int, 3>{v.x, v.y, v.z}); };
-  j.beginObject();
-  j.key("input").value(x.input);
-  j.key("dims").array(std::array<int, 3>{x.dims.nx, x.dims.ny, x.dims.nz});
-  j.key("type").value(io::toString(x.type));
-  j.key("spacing");
-  triple(x.geometry.spacing);
-  j.key("origin");
-  triple(x.geometry.origin);
-  j.key("direction").beginArray();
-  for (const auto& r : x.geometry.direction) triple(r);
-  j.endArray();
-  j.key("data_range").array(std::array<double, 2>{x.dataMin, x.dataMax});
-  j.key("selection").beginObject();
-  j.key("mode").value(x.byLabel ? "label" : "iso");
-  j.key(x.byLabel ? "label" : "iso").value(x.value);
-  if (!x.byLabel) j.key("iso_source").value(x.valueFromOtsu ? "otsu" : "given");
-  j.key("inside_voxels").value(x.insideVoxels);
-  j.endObject();
-  j.key("adjacency").value(toString(x.pair));
-  j.key("mapping").value(x.mapping);
-  j.key("seed").beginObject();
+  json j;
+  j["input"] = x.input;
+  j["dims"] = {x.dims.nx, x.dims.ny, x.dims.nz};
+  j["type"] = io::toString(x.type);
+  j["spacing"] = numbers(x.geometry.spacing);
+  j["origin"] = numbers(x.geometry.origin);
+  j["direction"] = directionJson(x.geometry);
+  j["data_range"] = {number(x.dataMin), number(x.dataMax)};
+  json selection;
+  selection["mode"] = x.byLabel ? "label" : "iso";
+  selection[x.byLabel ? "label" : "iso"] = number(x.value);
+  if (!x.byLabel) selection["iso_source"] = x.valueFromOtsu ? "otsu" : "given";
+  selection["inside_voxels"] = x.insideVoxels;
+  j["selection"] = std::move(selection);
+  j["adjacency"] = toString(x.pair);
+  j["mapping"] = x.mapping;
+  json seed;
   static const char* modes[] = {"largest", "all", "voxel", "surfel", "point"};
-  j.key("mode").value(modes[int(x.seedMode)]);
-  if (x.seedPoint) {
-    j.key("point");
-    triple(*x.seedPoint);
-  }
+  seed["mode"] = modes[int(x.seedMode)];
+  if (x.seedPoint) seed["point"] = numbers(*x.seedPoint);
   if (x.seedVoxel) {
-    j.key("voxel");
-    voxel(*x.seedVoxel);
-    j.key("voxel_inside").value(x.seedVoxelInside);
+    seed["voxel"] = voxelJson(*x.seedVoxel);
+    seed["voxel_inside"] = x.seedVoxelInside;
   }
   if (x.walkDirection) {
-    j.key("walk_direction").value(directionName(*x.walkDirection));
-    j.key("walk_steps").value(x.walkSteps);
+    seed["walk_direction"] = directionName(*x.walkDirection);
+    seed["walk_steps"] = x.walkSteps;
   }
-  if (x.seedSurfel) {
-    j.key("surfel").beginObject();
-    j.key("c");
-    voxel(x.seedSurfel->inside());
-    j.key("d");
-    voxel(x.seedSurfel->outside());
-    j.endObject();
-  }
-  if (x.seedMode == SeedMode::Largest || x.seedMode == SeedMode::All) j.key("boundaries").value(x.boundaries);
-  j.endObject();
-  j.key("surfels").value(x.surfels);
-  j.key("vertices").value(m.vertices);
-  j.key("edges").value(m.edges);
-  j.key("triangles").value(m.triangles);
-  j.key("components").value(m.components.size());
-  j.key("euler_characteristic").value(m.euler);
-  if (m.components.size() == 1) j.key("genus").value(m.components[0].genus());
-  j.key("closed").value(m.closed);
-  j.key("manifold").value(m.manifold);
-  j.key("bbox").beginObject();
-  j.key("min");
-  triple(m.min);
-  j.key("max");
-  triple(m.max);
-  j.endObject();
+  if (x.seedSurfel)
+    seed["surfel"] = {{"c", voxelJson(x.seedSurfel->inside())}, {"d", voxelJson(x.seedSurfel->outside())}};
+  if (x.seedMode == SeedMode::Largest || x.seedMode == SeedMode::All) seed["boundaries"] = x.boundaries;
+  j["seed"] = std::move(seed);
+  j["surfels"] = x.surfels;
+  j["vertices"] = m.vertices;
+  j["edges"] = m.edges;
+  j["triangles"] = m.triangles;
+  j["components"] = m.components.size();
+  j["euler_characteristic"] = m.euler;
+  if (m.components.size() == 1) j["genus"] = number(m.components[0].genus());
+  j["closed"] = m.closed;
+  j["manifold"] = m.manifold;
+  j["bbox"] = {{"min", numbers(m.min)}, {"max", numbers(m.max)}};
   constexpr std::size_t kListed = 100;
-  j.key("component_list").beginArray();
+  json components = json::array();
   for (std::size_t i = 0; i < m.components.size() && i < kListed; ++i) {
     const auto& c = m.components[i];
-    j.beginObject();
-    j.key("vertices").value(c.vertices);
-    j.key("edges").value(c.edges);
-    j.key("triangles").value(c.triangles);
-    j.key("euler_characteristic").value(c.euler);
-    j.key("genus").value(c.genus());
-    j.key("area").value(c.area);
-    j.key("enclosed_volume").value(c.volume);
-    j.endObject();
+    json component;
+    component["vertices"] = c.vertices;
+    component["edges"] = c.edges;
+    component["triangles"] = c.triangles;
+    component["euler_characteristic"] = c.euler;
+    component["genus"] = number(c.genus());
+    component["area"] = number(c.area);
+    component["enclosed_volume"] = number(c.volume);
+    components.push_back(std::move(component));
   }
-  j.endArray();
-  if (m.components.size() > kListed) j.key("component_list_truncated_to").value(kListed);
+  j["component_list"] = std::move(components);
+  if (m.components.size() > kListed) j["component_list_truncated_to"] = kListed;
   if (!x.output.empty()) {
-    j.key("output").beginObject();
-    j.key("path").value(x.output);
-    j.key("format").value(x.format);
-    j.key("binary").value(x.binary);
-    j.key("bytes").value((unsigned long long)x.bytes);
-    j.endObject();
+    json output;
+    output["path"] = x.output;
+    output["format"] = x.format;
+    output["binary"] = x.binary;
+    output["bytes"] = x.bytes;
+    j["output"] = std::move(output);
   }
-  j.key("timings_s").beginObject();
-  for (const auto& t : x.timings) j.key(t.name).value(t.seconds);
-  j.key("total").value(x.totalSeconds);
-  j.endObject();
-  j.endObject();
+  json timings = json::object();
+  for (const auto& t : x.timings) timings[t.name] = number(t.seconds);
+  timings["total"] = number(x.totalSeconds);
+  j["timings_s"] = std::move(timings);
+  return j;
 }
 
 void printVolumeInfo(std::ostream& out, const std::string& path, const io::AnyVolume& volume,
@@ -311,39 +313,32 @@ void printVolumeInfo(std::ostream& out, const std::string& path, const io::AnyVo
   }
 }
 
-void writeVolumeJson(JsonWriter& j, const std::string& path, const io::AnyVolume& volume,
-                     const VolumeStats& s) {
+json volumeJson(const std::string& path, const io::AnyVolume& volume, const VolumeStats& s) {
   const Dims& d = io::dimsOf(volume);
   const ImageGeometry& g = io::geometryOf(volume);
-  j.beginObject();
-  j.key("input").value(path);
-  j.key("dims").array(std::array<int, 3>{d.nx, d.ny, d.nz});
-  j.key("type").value(io::toString(io::scalarTypeOf(volume)));
-  j.key("spacing").array(g.spacing);
-  j.key("origin").array(g.origin);
-  j.key("direction").beginArray();
-  for (const auto& r : g.direction) j.array(r);
-  j.endArray();
-  j.key("min").value(s.min);
-  j.key("max").value(s.max);
-  j.key("mean").value(s.mean);
-  j.key("non_finite").value(s.nonFinite);
-  j.key("otsu").value(s.otsu);
-  j.key("histogram").beginObject();
-  j.key("bin_width").value(s.binWidth);
-  j.key("counts").array(s.histogram);
-  j.endObject();
+  json j;
+  j["input"] = path;
+  j["dims"] = {d.nx, d.ny, d.nz};
+  j["type"] = io::toString(io::scalarTypeOf(volume));
+  j["spacing"] = numbers(g.spacing);
+  j["origin"] = numbers(g.origin);
+  j["direction"] = directionJson(g);
+  j["min"] = number(s.min);
+  j["max"] = number(s.max);
+  j["mean"] = number(s.mean);
+  j["non_finite"] = s.nonFinite;
+  j["otsu"] = number(s.otsu);
+  j["histogram"] = {{"bin_width", number(s.binWidth)}, {"counts", s.histogram}};
   if (!s.labels.empty()) {
-    j.key("labels").beginArray();
-    for (auto [value, count] : s.labels) {
-      j.beginObject();
-      j.key("value").value((long long)value);
-      j.key("voxels").value(count);
-      j.endObject();
-    }
-    j.endArray();
+    json labels = json::array();
+    for (auto [value, count] : s.labels) labels.push_back({{"value", value}, {"voxels", count}});
+    j["labels"] = std::move(labels);
   }
-  j.endObject();
+  return j;
+}
+
+std::string jsonText(const json& j) {
+  return j.dump(2, ' ', false, json::error_handler_t::replace);
 }
 
 }  // namespace surftrack::cli

@@ -5,8 +5,9 @@
 #include <ostream>
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "Extraction.h"
-#include "Json.h"
 #include "ReadVolume.h"
 #include "VolumeStats.h"
 
@@ -15,14 +16,18 @@ namespace surftrack::cli {
 /// The summary of an extraction, a dozen lines, each "  label   text".
 void printSummary(std::ostream& out, const Extraction& x);
 
-/// The extraction as one JSON object (written into `json`, which may be inside an array).
-void writeJson(JsonWriter& json, const Extraction& x);
+/// The extraction as one JSON object (keys in the order written; `demo` puts it in an array).
+nlohmann::ordered_json extractionJson(const Extraction& x);
 
 /// `surftrack info`: the description of a volume.
 void printVolumeInfo(std::ostream& out, const std::string& path, const io::AnyVolume& volume,
                      const VolumeStats& stats);
-void writeVolumeJson(JsonWriter& json, const std::string& path, const io::AnyVolume& volume,
-                     const VolumeStats& stats);
+nlohmann::ordered_json volumeJson(const std::string& path, const io::AnyVolume& volume,
+                                  const VolumeStats& stats);
+
+/// The text --json prints: indented by 2, one value per line, invalid UTF-8 in strings (a
+/// file name) replaced by U+FFFD.
+std::string jsonText(const nlohmann::ordered_json& json);
 
 /// "c=(x,y,z) d=(x,y,z)".
 std::string surfelText(const Surfel& s);
