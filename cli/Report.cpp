@@ -116,6 +116,19 @@ json number(double v) {
   return v;
 }
 
+/// The seed rule's name in the JSON (a switch, not a table indexed by the enum: a new rule is a
+/// -Wswitch warning here, not a read past the table).
+const char* seedModeName(SeedMode m) {
+  switch (m) {
+    case SeedMode::Largest: return "largest";
+    case SeedMode::All: return "all";
+    case SeedMode::Voxel: return "voxel";
+    case SeedMode::Surfel: return "surfel";
+    case SeedMode::Point: return "point";
+  }
+  return "?";
+}
+
 json numbers(const std::array<double, 3>& p) { return {number(p[0]), number(p[1]), number(p[2])}; }
 
 json voxelJson(Voxel v) { return {v.x, v.y, v.z}; }
@@ -216,8 +229,7 @@ json extractionJson(const Extraction& x) {
   j["adjacency"] = toString(x.pair);
   j["mapping"] = x.mapping;
   json seed;
-  static const char* modes[] = {"largest", "all", "voxel", "surfel", "point"};
-  seed["mode"] = modes[int(x.seedMode)];
+  seed["mode"] = seedModeName(x.seedMode);
   if (x.seedPoint) seed["point"] = numbers(*x.seedPoint);
   if (x.seedVoxel) {
     seed["voxel"] = voxelJson(*x.seedVoxel);
