@@ -25,6 +25,9 @@
 #include "ConfigurationTable.h"
 #include "DigitalCube.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 namespace surftrack {
 namespace scan {
 namespace {
@@ -70,11 +73,19 @@ struct PlaneEdges {
   std::vector<std::uint32_t> y;  // edge (x, y, z)-(x, y + 1, z)
 };
 
+/// The scan of one binary image. Count, prefix sum, fill (as OpenVDB's VolumeToMesh does): the
+/// image is binarised plane by plane, the vertices and triangles of every slab z..z+1 are
+/// counted, and then runs of slabs are filled in parallel, each writing its vertices and
+/// triangles at the offsets the counts give. Vertex indices do not depend on who numbers them,
+/// so the mesh is the same, to the byte, for any number of threads.
 class Scanner {
  public:
-  Scanner(const Dims& dims, AdjacencyPair pair, const RowSource& rows)
+  Scanner(const Dims& dims, AdjacencyPair pair, const RowSource& rows, int threads)
       : dims_(dims), words_(rowWords(dims.nx)), rowCount_(dims.ny + 2),
-        columns_(std::size_t(dims.nx) + 2) {
+        columns_(std::size_t(dims.nx) + 2),
+        // Left to choose (0), small images take one thread: waking threads would cost more.
+        threads_(threads == 0 && dims.count() < (std::size_t(1) << 18) ? 1 : threads),
+        arena_(threads_ > 0 ? threads_ : tbb::task_arena::automatic) {
     for (int config = 0; config < 256; ++config)
       table_[config] = &configurationTable(pair, std::uint8_t(config));
     // Valid bits: cubes and x-edges have their low voxel x in [-1, nx - 1]; voxels, y- and
@@ -86,70 +97,121 @@ class Scanner {
       voxelMask_[b >> 6] |= bit(b);
       if (x < dims.nx) cubeMask_[b >> 6] |= bit(b);
     }
-    // The whole binary image, planes z = -1 .. nz, read once.
+    // The whole binary image, planes z = -1 .. nz, read once (RowSource::fillRow may be called
+    // from several threads at once).
     bits_.assign(std::size_t(dims.nz + 2) * rowCount_ * words_, 0);
-    for (int z = -1; z <= dims.nz; ++z)
+    forEach(-1, dims.nz + 1, [&](int z) {
       for (int j = 0; j < rowCount_; ++j) rows.fillRow(j - 1, z, mutableRow(z, j));
-    for (PlaneEdges* p : {&bottom_, &top_}) {
-      p->x.assign(std::size_t(rowCount_) * columns_, 0);
-      p->y.assign(std::size_t(rowCount_) * columns_, 0);
-    }
-    zEdge_.assign(2 * columns_, 0);
+    });
   }
 
   TriangleMesh run() {
-    // Allocating the mesh once costs much less than growing it (copies, page faults) on
-    // noisy images. A closed surface of genus g with V vertices has 2V - 4 + 4g triangles.
-    const std::size_t surfels = countSurfels();
-    mesh_.surfels.reserve(surfels);
-    mesh_.triangles.reserve(2 * surfels);
-    for (int j = 0; j < rowCount_; ++j) numberPlaneEdges(-1, j, bottom_);
-    for (int z = -1; z < dims_.nz; ++z) {
-      // Row by row, so that the indices just written are still in cache when read: the cubes
-      // of row j need the edges of rows j and j + 1.
+    // Slab s = z + 1 in [0, nz + 1) is the iteration that numbers the x-, y-edges of plane
+    // z + 1 and the z-edges between z and z + 1, and emits the triangles of its cubes; plane
+    // -1's edges come first of all.
+    const int slabs = dims_.nz + 1;
+    std::vector<std::size_t> vertexStart(slabs + 1), triangleStart(slabs + 1);
+    std::size_t prologue = 0;
+    for (int j = 0; j < rowCount_; ++j) prologue += planeRowCount(-1, j);
+    forEach(0, slabs, [&](int s) {
+      const int z = s - 1;
+      std::size_t v = 0, t = 0;
       for (int j = 0; j < rowCount_; ++j) {
-        numberPlaneEdges(z + 1, j, top_);
-        numberSlabEdges(z, j);
-        if (j > 0) marchRow(z, j - 1);
+        v += planeRowCount(z + 1, j) + slabRowCount(z, j);
+        if (j > 0) t += rowTriangleCount(z, j - 1);
       }
-      std::swap(bottom_, top_);
-    }
-    return std::move(mesh_);
+      vertexStart[s + 1] = v;
+      triangleStart[s + 1] = t;
+    });
+    vertexStart[0] = prologue;
+    std::partial_sum(vertexStart.begin(), vertexStart.end(), vertexStart.begin());
+    std::partial_sum(triangleStart.begin(), triangleStart.end(), triangleStart.begin());
+    if (vertexStart[slabs] > std::numeric_limits<std::uint32_t>::max())
+      throw std::length_error("scanIsoSurface: more than 2^32 - 1 boundary surfels");
+
+    TriangleMesh mesh;
+    mesh.surfels.resize(vertexStart[slabs]);
+    mesh.triangles.resize(triangleStart[slabs]);
+    // Runs of slabs of about equal work; a run re-numbers its first plane's edges itself.
+    const int runs = threads_ == 1 ? 1 : std::min(slabs, 8 * std::max(1, arena_.max_concurrency()));
+    forEach(0, runs, [&](int r) {
+      const int first = int(std::int64_t(slabs) * r / runs), last = int(std::int64_t(slabs) * (r + 1) / runs);
+      Run run(*this, mesh);
+      if (first == 0) {
+        run.vertex = 0;
+        for (int j = 0; j < rowCount_; ++j) run.numberPlaneEdges(-1, j, run.bottom, true);
+      } else {
+        // Plane first - 1 was numbered by slab first - 1, row by row between that slab's
+        // z-edges: replay the indices without writing the vertices.
+        run.vertex = std::uint32_t(vertexStart[first - 1]);
+        for (int j = 0; j < rowCount_; ++j) {
+          run.numberPlaneEdges(first - 1, j, run.bottom, false);
+          run.vertex += std::uint32_t(slabRowCount(first - 2, j));
+        }
+      }
+      run.triangle = triangleStart[first];
+      for (int s = first; s < last; ++s) {
+        const int z = s - 1;
+        // Row by row, so that the indices just written are still in cache when read: the
+        // cubes of row j need the edges of rows j and j + 1.
+        for (int j = 0; j < rowCount_; ++j) {
+          run.numberPlaneEdges(z + 1, j, run.top, true);
+          run.numberSlabEdges(z, j);
+          if (j > 0) run.marchRow(z, j - 1);
+        }
+        std::swap(run.bottom, run.top);
+      }
+    });
+    return mesh;
   }
 
  private:
-  std::uint64_t* mutableRow(int z, int j) {
-    return bits_.data() + (std::size_t(z + 1) * rowCount_ + j) * words_;
+  /// f(i) for i in [begin, end): on the arena's threads, or in order on this one.
+  template <class F>
+  void forEach(int begin, int end, F&& f) {
+    if (threads_ == 1) {
+      for (int i = begin; i < end; ++i) f(i);
+      return;
+    }
+    arena_.execute([&] { tbb::parallel_for(begin, end, f); });
   }
+
   const std::uint64_t* row(int z, int j) const {
     return bits_.data() + (std::size_t(z + 1) * rowCount_ + j) * words_;
   }
+  std::uint64_t* mutableRow(int z, int j) {
+    return bits_.data() + (std::size_t(z + 1) * rowCount_ + j) * words_;
+  }
 
-  /// The number of cut grid edges, i.e. of boundary surfels.
-  std::size_t countSurfels() const {
+  /// Cut x- and y-edges of row j of plane z; cut z-edges of row j between planes z and z + 1.
+  std::size_t planeRowCount(int z, int j) const {
+    const std::uint64_t* r = row(z, j);
+    const std::uint64_t* up = j + 1 < rowCount_ ? row(z, j + 1) : nullptr;
     std::size_t n = 0;
-    for (int z = -1; z <= dims_.nz; ++z)
-      for (int j = 0; j < rowCount_; ++j) {
-        const std::uint64_t* r = row(z, j);
-        const std::uint64_t* up = j + 1 < rowCount_ ? row(z, j + 1) : r;  // y-edges
-        const std::uint64_t* next = z < dims_.nz ? row(z + 1, j) : r;     // z-edges
-        for (int w = 0; w < words_ - 1; ++w) {
-          const std::uint64_t cuts = ((r[w] ^ nextBits(r, w)) & cubeMask_[w]) |
-                                     ((r[w] ^ up[w]) & voxelMask_[w]) | ((r[w] ^ next[w]) & voxelMask_[w]);
-          if (cuts)  // most words of most images: no popcount at all
-            n += std::popcount((r[w] ^ nextBits(r, w)) & cubeMask_[w]) +
-                 std::popcount((r[w] ^ up[w]) & voxelMask_[w]) +
-                 std::popcount((r[w] ^ next[w]) & voxelMask_[w]);
-        }
-      }
+    for (int w = 0; w < words_ - 1; ++w) {
+      n += std::popcount((r[w] ^ nextBits(r, w)) & cubeMask_[w]);
+      if (up) n += std::popcount((r[w] ^ up[w]) & voxelMask_[w]);
+    }
+    return n;
+  }
+  std::size_t slabRowCount(int z, int j) const {
+    const std::uint64_t* lo = row(z, j);
+    const std::uint64_t* hi = row(z + 1, j);
+    std::size_t n = 0;
+    for (int w = 0; w < words_ - 1; ++w) n += std::popcount((lo[w] ^ hi[w]) & voxelMask_[w]);
     return n;
   }
 
-  std::uint32_t addVertex(const Surfel& s) {
-    if (mesh_.surfels.size() >= std::numeric_limits<std::uint32_t>::max())
-      throw std::length_error("scanIsoSurface: more than 2^32 - 1 boundary surfels");
-    mesh_.surfels.push_back(s);
-    return std::uint32_t(mesh_.surfels.size() - 1);
+  unsigned cubeConfig(const std::uint64_t* const r[4], int b) const {
+    return twoBits(r[0], b) | (twoBits(r[1], b) << 2) | (twoBits(r[2], b) << 4) | (twoBits(r[3], b) << 6);
+  }
+  std::size_t rowTriangleCount(int z, int j) const {
+    const std::uint64_t* const r[4] = {row(z, j), row(z, j + 1), row(z + 1, j), row(z + 1, j + 1)};
+    std::size_t n = 0;
+    for (int w = 0; w < words_ - 1; ++w)
+      forEachBit(mixedCubes(r[0], r[1], r[2], r[3], w) & cubeMask_[w], w,
+                 [&](int b) { n += table_[cubeConfig(r, b)]->allTriangles().size(); });
+    return n;
   }
 
   /// The surfel on the grid edge from `low` to low + e_axis, whose low voxel has value `lowValue`.
@@ -160,83 +222,100 @@ class Scanner {
     return Surfel{high, directionOf(axis, -1)};
   }
 
-  /// Vertex indices for the cut x- and y-edges of row j (y = j - 1) of plane z.
-  void numberPlaneEdges(int z, int j, PlaneEdges& ids) {
-    const std::uint64_t* r = row(z, j);
-    const std::uint64_t* up = j + 1 < rowCount_ ? row(z, j + 1) : nullptr;
-    std::uint32_t* xIds = ids.x.data() + std::size_t(j) * columns_;
-    std::uint32_t* yIds = ids.y.data() + std::size_t(j) * columns_;
-    const int y = j - 1;
-    for (int w = 0; w < words_ - 1; ++w) {
-      forEachBit((r[w] ^ nextBits(r, w)) & cubeMask_[w], w, [&](int b) {
-        const int x = b - kRowOffset;
-        xIds[x + 1] = addVertex(edgeSurfel({x, y, z}, 0, (r[w] >> (b & 63)) & 1));
-      });
-      if (up)
-        forEachBit((r[w] ^ up[w]) & voxelMask_[w], w, [&](int b) {
+  /// One thread's run of slabs: its edge-index planes and its cursors into the mesh.
+  struct Run {
+    Run(const Scanner& scanner, TriangleMesh& mesh) : s(scanner), mesh(mesh) {
+      for (PlaneEdges* p : {&bottom, &top}) {
+        p->x.assign(std::size_t(s.rowCount_) * s.columns_, 0);
+        p->y.assign(std::size_t(s.rowCount_) * s.columns_, 0);
+      }
+      zEdge.assign(2 * s.columns_, 0);
+    }
+
+    std::uint32_t addVertex(const Surfel& surfel, bool write) {
+      if (write) mesh.surfels[vertex] = surfel;
+      return vertex++;
+    }
+
+    /// Vertex indices for the cut x- and y-edges of row j (y = j - 1) of plane z.
+    void numberPlaneEdges(int z, int j, PlaneEdges& ids, bool write) {
+      const std::uint64_t* r = s.row(z, j);
+      const std::uint64_t* up = j + 1 < s.rowCount_ ? s.row(z, j + 1) : nullptr;
+      std::uint32_t* xIds = ids.x.data() + std::size_t(j) * s.columns_;
+      std::uint32_t* yIds = ids.y.data() + std::size_t(j) * s.columns_;
+      const int y = j - 1;
+      for (int w = 0; w < s.words_ - 1; ++w) {
+        forEachBit((r[w] ^ nextBits(r, w)) & s.cubeMask_[w], w, [&](int b) {
           const int x = b - kRowOffset;
-          yIds[x + 1] = addVertex(edgeSurfel({x, y, z}, 1, (r[w] >> (b & 63)) & 1));
+          xIds[x + 1] = addVertex(edgeSurfel({x, y, z}, 0, (r[w] >> (b & 63)) & 1), write);
+        });
+        if (up)
+          forEachBit((r[w] ^ up[w]) & s.voxelMask_[w], w, [&](int b) {
+            const int x = b - kRowOffset;
+            yIds[x + 1] = addVertex(edgeSurfel({x, y, z}, 1, (r[w] >> (b & 63)) & 1), write);
+          });
+      }
+    }
+
+    /// Vertex indices for the cut z-edges of row j between planes z and z + 1.
+    void numberSlabEdges(int z, int j) {
+      const std::uint64_t* lo = s.row(z, j);
+      const std::uint64_t* hi = s.row(z + 1, j);
+      std::uint32_t* zIds = zEdge.data() + std::size_t(j & 1) * s.columns_;
+      for (int w = 0; w < s.words_ - 1; ++w)
+        forEachBit((lo[w] ^ hi[w]) & s.voxelMask_[w], w, [&](int b) {
+          const int x = b - kRowOffset;
+          zIds[x + 1] = addVertex(edgeSurfel({x, j - 1, z}, 2, (lo[w] >> (b & 63)) & 1), true);
         });
     }
-  }
 
-  /// Vertex indices for the cut z-edges of row j between planes z and z + 1.
-  void numberSlabEdges(int z, int j) {
-    const std::uint64_t* lo = row(z, j);
-    const std::uint64_t* hi = row(z + 1, j);
-    std::uint32_t* zIds = zEdge_.data() + std::size_t(j & 1) * columns_;
-    for (int w = 0; w < words_ - 1; ++w)
-      forEachBit((lo[w] ^ hi[w]) & voxelMask_[w], w, [&](int b) {
-        const int x = b - kRowOffset;
-        zIds[x + 1] = addVertex(edgeSurfel({x, j - 1, z}, 2, (lo[w] >> (b & 63)) & 1));
-      });
-  }
+    /// Emits the triangles of every non-trivial cube with min corner y = j - 1 in the slab
+    /// between planes z and z + 1.
+    void marchRow(int z, int j) {
+      // Corner rows: r[c] holds the corners with y-bit c & 1 and z-bit c >> 1.
+      const std::uint64_t* const r[4] = {s.row(z, j), s.row(z, j + 1), s.row(z + 1, j), s.row(z + 1, j + 1)};
+      // Vertex-index rows of the 12 cube edges (DigitalCube.h), to be read at column i = x + 1.
+      const std::size_t at = std::size_t(j) * s.columns_, above = at + s.columns_;
+      const std::size_t zAt = std::size_t(j & 1) * s.columns_, zAbove = std::size_t((j + 1) & 1) * s.columns_;
+      const std::array<const std::uint32_t*, 12> edge = {
+          bottom.x.data() + at, bottom.x.data() + above,  // x-edges: y-bit, z-bit
+          top.x.data() + at,    top.x.data() + above,
+          bottom.y.data() + at, bottom.y.data() + at + 1,  // y-edges: x-bit, z-bit
+          top.y.data() + at,    top.y.data() + at + 1,
+          zEdge.data() + zAt,    zEdge.data() + zAt + 1,     // z-edges: x-bit, y-bit
+          zEdge.data() + zAbove, zEdge.data() + zAbove + 1};
+      for (int w = 0; w < s.words_ - 1; ++w)
+        forEachBit(mixedCubes(r[0], r[1], r[2], r[3], w) & s.cubeMask_[w], w, [&](int b) {
+          const int i = b - kRowOffset + 1;
+          for (const auto& t : s.table_[s.cubeConfig(r, b)]->allTriangles())
+            mesh.triangles[triangle++] = {edge[t[0]][i], edge[t[1]][i], edge[t[2]][i]};
+        });
+    }
 
-  /// Emits the triangles of every non-trivial cube with min corner y = j - 1 in the slab
-  /// between planes z and z + 1.
-  void marchRow(int z, int j) {
-    // Corner rows: rc holds the corners with y-bit c & 1 and z-bit c >> 1.
-    const std::uint64_t* r0 = row(z, j);
-    const std::uint64_t* r1 = row(z, j + 1);
-    const std::uint64_t* r2 = row(z + 1, j);
-    const std::uint64_t* r3 = row(z + 1, j + 1);
-    // Vertex-index rows of the 12 cube edges (DigitalCube.h), to be read at column i = x + 1.
-    const std::size_t at = std::size_t(j) * columns_, above = at + columns_;
-    const std::size_t zAt = std::size_t(j & 1) * columns_, zAbove = std::size_t((j + 1) & 1) * columns_;
-    const std::array<const std::uint32_t*, 12> edge = {
-        bottom_.x.data() + at, bottom_.x.data() + above,  // x-edges: y-bit, z-bit
-        top_.x.data() + at,    top_.x.data() + above,
-        bottom_.y.data() + at, bottom_.y.data() + at + 1,  // y-edges: x-bit, z-bit
-        top_.y.data() + at,    top_.y.data() + at + 1,
-        zEdge_.data() + zAt,    zEdge_.data() + zAt + 1,     // z-edges: x-bit, y-bit
-        zEdge_.data() + zAbove, zEdge_.data() + zAbove + 1};
-    for (int w = 0; w < words_ - 1; ++w)
-      forEachBit(mixedCubes(r0, r1, r2, r3, w) & cubeMask_[w], w, [&](int b) {
-        const unsigned config =
-            twoBits(r0, b) | (twoBits(r1, b) << 2) | (twoBits(r2, b) << 4) | (twoBits(r3, b) << 6);
-        const int i = b - kRowOffset + 1;
-        for (const auto& t : table_[config]->allTriangles())
-          mesh_.triangles.push_back({edge[t[0]][i], edge[t[1]][i], edge[t[2]][i]});
-      });
-  }
+    const Scanner& s;
+    TriangleMesh& mesh;
+    PlaneEdges bottom, top;             // planes z and z + 1 of the current slab
+    std::vector<std::uint32_t> zEdge;   // z-edges of the slab, rows j and j + 1 at j & 1
+    std::uint32_t vertex = 0;
+    std::size_t triangle = 0;
+  };
 
   Dims dims_;
   int words_;
   int rowCount_;
   std::size_t columns_;
+  int threads_;
+  tbb::task_arena arena_;
   std::array<const CubeTriangulation*, 256> table_{};
   std::vector<std::uint64_t> cubeMask_, voxelMask_;
   std::vector<std::uint64_t> bits_;  // planes z = -1 .. nz of rowCount_ rows of words_ words
-  PlaneEdges bottom_, top_;          // planes z and z + 1 of the current slab
-  std::vector<std::uint32_t> zEdge_;  // z-edges of the slab, rows j and j + 1 at j & 1
-  TriangleMesh mesh_;
 };
 
 }  // namespace
 
-TriangleMesh scanRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows) {
+TriangleMesh scanRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows, int threads) {
   if (dims.empty()) return {};
-  return Scanner(dims, pair, rows).run();
+  return Scanner(dims, pair, rows, threads).run();
 }
 
 }  // namespace scan

@@ -55,8 +55,9 @@ class RowSource {
 };
 
 /// The scanning engine: the kappa-lambda-iso-surface of the binary image that `rows`
-/// describes on the domain `dims` (cubes with min corner in [-1, n - 1] on each axis).
-TriangleMesh scanRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows);
+/// describes on the domain `dims` (cubes with min corner in [-1, n - 1] on each axis), on
+/// `threads` threads (0: all cores). The mesh is the same for any number of threads.
+TriangleMesh scanRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows, int threads = 0);
 
 /// Rows of any binary image, one operator() call per voxel.
 template <class BinaryImage>
@@ -118,21 +119,22 @@ class WordRows final : public RowSource {
 
 /// The kappa-lambda-iso-surface of a binary image through its generic operator() (any image).
 template <class BinaryImage>
-TriangleMesh scanIsoSurfaceGeneric(const BinaryImage& image, AdjacencyPair pair) {
-  return scan::scanRows(image.dims(), pair, scan::GenericRows<BinaryImage>(image));
+TriangleMesh scanIsoSurfaceGeneric(const BinaryImage& image, AdjacencyPair pair, int threads = 0) {
+  return scan::scanRows(image.dims(), pair, scan::GenericRows<BinaryImage>(image), threads);
 }
 
 /// The kappa-lambda-iso-surface of a whole binary image (paper §5.1): the triangles of the
 /// configuration table of `pair` in every digital 3-cube meeting the domain, oriented from the
 /// 1-voxels to the 0-voxels, one vertex per boundary surfel. Reads whole rows of a RowReadable
 /// image (ThresholdImage, and so binaryView; LabelImage), voxel by voxel otherwise; both give
-/// the same mesh.
+/// the same mesh, on `threads` threads (0: all cores; `image` is then read from several threads
+/// at once), the same mesh for any number.
 template <class BinaryImage>
-TriangleMesh scanIsoSurface(const BinaryImage& image, AdjacencyPair pair) {
+TriangleMesh scanIsoSurface(const BinaryImage& image, AdjacencyPair pair, int threads = 0) {
   if constexpr (scan::RowReadable<BinaryImage>)
-    return scan::scanRows(image.dims(), pair, scan::WordRows<BinaryImage>(image));
+    return scan::scanRows(image.dims(), pair, scan::WordRows<BinaryImage>(image), threads);
   else
-    return scanIsoSurfaceGeneric(image, pair);
+    return scanIsoSurfaceGeneric(image, pair, threads);
 }
 
 /// Connected components of a mesh's triangles through shared vertices: returns the component

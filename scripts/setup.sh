@@ -12,6 +12,7 @@ packages=(
   libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip size checks)
   libcli11-dev                   # CLI11: the command line
   nlohmann-json3-dev             # nlohmann-json: the CLI's JSON output
+  libtbb-dev                     # oneTBB: the scanning method on every core
   gnuplot-nox                    # plots of the Figure 9 benchmark
   python3-dev python3-numpy pybind11-dev   # the Python package (Debian's python3, /usr/bin/python3)
   python3-pytest python3-skimage python3-nibabel python3-meshio  # its tests and examples

@@ -163,6 +163,25 @@ TEST(ScanIsoSurface, VerticesAreTheBoundarySurfelsAndTheMeshIsClosedAndOriented)
   EXPECT_EQ(images, 600);
 }
 
+// Count, prefix sum, fill in runs of slabs: the mesh does not depend on the number of threads,
+// down to the vertex numbering.
+TEST(ScanIsoSurface, EveryThreadCountGivesTheSameMesh) {
+  auto check = [](const auto& image, AdjacencyPair pair, const char* what) {
+    const TriangleMesh one = scanIsoSurface(image, pair, 1);
+    for (int threads : {2, 7, 0}) {
+      const TriangleMesh many = scanIsoSurface(image, pair, threads);
+      ASSERT_EQ(many.surfels, one.surfels) << what << " " << toString(pair) << " threads " << threads;
+      ASSERT_EQ(many.triangles, one.triangles) << what << " " << toString(pair) << " threads " << threads;
+    }
+  };
+  for (AdjacencyPair pair : kAllAdjacencyPairs) {
+    for (const BinaryVolume& v : randomImages(40, 31)) check(binaryView(v), pair, "random");
+    for (Dims d : kWordBoundaryDims) check(binaryView(randomVolume(d, 0.5, 5 + d.nx)), pair, "word boundaries");
+    const bench::NoisySphere sphere = bench::makeNoisySphere(48, 0.05, 9);
+    check(sphere.binary(), pair, "sphere");
+  }
+}
+
 TEST(ScanIsoSurface, EmptyFullAndSingleVoxelImages) {
   for (AdjacencyPair pair : kAllAdjacencyPairs) {
     const BinaryVolume empty({5, 4, 3}, 0), full({5, 4, 3}, 1), one({1, 1, 1}, 1);

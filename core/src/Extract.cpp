@@ -192,6 +192,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   if (out.mapping == Mapping::Linear && o.selection.isLabel())
     throw InvalidInput("the linear mapping interpolates an iso-value: a label selection takes the "
                        "midpoint mapping");
+  if (o.threads < 0) throw InvalidInput("threads " + std::to_string(o.threads) + " is negative (0: all cores)");
   if (!(o.epsilon > 0 && o.epsilon < 0.5))
     throw InvalidInput("epsilon " + numberText(o.epsilon) + " is outside ]0, 0.5[");
 
@@ -202,7 +203,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   TriangleMesh mesh;
   if (scanning) {
     stages.begin("scan");
-    mesh = scanIsoSurface(binary, o.pair);
+    mesh = scanIsoSurface(binary, o.pair, o.threads);
     if (mesh.surfels.empty()) throwEmpty(source, o.selection);
   } else {
     stages.begin("seed");
@@ -210,7 +211,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
     std::size_t expected = 0;
     switch (o.seed.kind) {
       case Kind::Largest: {
-        const TriangleMesh all = scanIsoSurface(binary, o.pair);
+        const TriangleMesh all = scanIsoSurface(binary, o.pair, o.threads);
         std::size_t count = 0;
         const std::vector<std::uint32_t> component = meshComponents(all, count);
         if (count == 0) throwEmpty(source, o.selection);

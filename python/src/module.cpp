@@ -80,7 +80,8 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
                       double value, const std::string& seedKind, std::array<double, 6> seed,
                       const std::string& adjacency, const std::string& mapping, double epsilon,
                       std::array<double, 3> spacing, std::array<double, 3> origin,
-                      std::array<std::array<double, 3>, 3> direction, py::object progress) {
+                      std::array<std::array<double, 3>, 3> direction, int threads,
+                      py::object progress) {
   if (volume.ndim() != 3)
     throw py::value_error("the volume must be 3-D, not " + std::to_string(volume.ndim()) + "-D");
   const ScalarType type = scalarTypeOfDtype(volume.dtype());
@@ -105,6 +106,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
   o.pair = parseAdjacencyPair(adjacency);
   o.mapping = parseMapping(mapping);
   o.epsilon = epsilon;
+  o.threads = threads;
   auto engineVoxel = [&](int first) {
     Voxel v;
     for (int e = 0; e < 3; ++e) v[e] = int(seed[first + order[e]]);

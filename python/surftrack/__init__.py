@@ -132,7 +132,7 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
             mode: str = "seed", seed_rule: str = "nearest", adjacency: str = "26-6",
             mapping: str = "default",
             spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, affine=None,
-            epsilon: float = 1e-3,
+            epsilon: float = 1e-3, threads: int = 0,
             progress: Optional[Callable[[str, int, int, int], None]] = None) -> Surface:
     """The surface of one boundary (mode="seed"), of the largest, or of all boundaries.
 
@@ -143,7 +143,8 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     crossed instead. ``mapping`` places each
     vertex on its surfel's segment: "linear" (iso-value interpolation, the default for a
     level), "midpoint" (the default for a label). ``progress(stage, index, stages, surfels)``
-    is called at each stage and while tracking. ``affine`` (a 4x4 voxel-to-world matrix, as
+    is called at each stage and while tracking. ``threads`` (0: all cores) runs the scan of
+    "largest" and "all" in parallel; the surface is the same for any number. ``affine`` (a 4x4 voxel-to-world matrix, as
     nibabel's ``img.affine``) replaces spacing, origin and direction. Raises ValueError /
     TypeError on bad input.
     """
@@ -208,7 +209,7 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     try:
         out = _surftrack.extract_array(array, order, kind, value, seed_kind, seed_values,
                                        adjacency, mapping, float(epsilon), spacing, origin,
-                                       direction.tolist(), progress)
+                                       direction.tolist(), int(threads), progress)
     except ValueError as error:
         note = _range_note(array, value) if kind == "threshold" else ""
         raise ValueError(f"{error}{note}") from None

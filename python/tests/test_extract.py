@@ -40,6 +40,15 @@ def test_memory_orders_give_the_same_surface():
         surftrack.extract(flipped.copy(), level=level, mode="all"))
 
 
+def test_every_thread_count_gives_the_same_surface():
+    volume = smooth_volume(np.random.default_rng(5), (70, 64, 66))
+    level = float(np.median(volume))
+    ref = surftrack.extract(volume, level=level, mode="all", threads=1)
+    for threads in (2, 7, 0):
+        s = surftrack.extract(volume, level=level, mode="all", threads=threads)
+        assert np.array_equal(s.vertices, ref.vertices) and np.array_equal(s.faces, ref.faces)
+
+
 @pytest.mark.parametrize("dtype", DTYPES)
 def test_every_dtype_gives_the_same_surface(dtype):
     volume = ball((14, 15, 16), (7, 7.5, 8), 4.5, dtype=np.uint8, value=1).astype(dtype)
@@ -114,6 +123,7 @@ def test_progress_and_write(tmp_path):
     (np.arange(64.0).reshape(4, 4, 4), {"level": 10}, ValueError, "seed"),
     (np.arange(64, dtype=np.uint8).reshape(4, 4, 4), {"label": 300, "mode": "all"}, ValueError, "label 300"),
     (np.arange(64.0).reshape(4, 4, 4), {"level": 10, "mode": "all", "spacing": (1, 0, 1)}, ValueError, "spacing"),
+    (np.arange(64.0).reshape(4, 4, 4), {"level": 10, "mode": "all", "threads": -1}, ValueError, "threads -1"),
 ])
 def test_bad_input(volume, kwargs, error, message):
     with pytest.raises(error, match=message):

@@ -81,6 +81,9 @@ struct ExtractOptions {
   std::function<void(const ProgressEvent&)> progress;
   /// If set and raised, the extraction stops at the next check and throws Cancelled.
   const std::atomic<bool>* cancel = nullptr;
+  /// Threads for the scanning method (largest, all): 0 for all cores. The surface is the same
+  /// for any number. The source is then read from several threads at once.
+  int threads = 0;
 };
 
 /// The figures of one connected component (one kappa-lambda-boundary, Proposition 39).

@@ -28,6 +28,8 @@ struct Selection {
   bool isLabel() const { return kind == Kind::Label; }
 };
 
+/// Every member is const and may be called from several threads at once (the scanning method
+/// reads planes in parallel).
 class VoxelSource {
  public:
   virtual ~VoxelSource() = default;
@@ -54,7 +56,8 @@ std::unique_ptr<VoxelSource> makeViewSource(const VolumeView& view);
 
 /// A source whose gray values come from a function f(x, y, z) on a domain, with no storage:
 /// it can describe volumes far too large to hold (a 4096^3 ball, say). f is called once per
-/// voxel read, only near the surface on a seeded extraction.
+/// voxel read, only near the surface on a seeded extraction; it must be safe to call from
+/// several threads at once (or extract with threads = 1).
 std::unique_ptr<VoxelSource> makeFunctionSource(Dims dims, std::function<double(int, int, int)> f,
                                                 const ImageGeometry& geometry = {});
 
