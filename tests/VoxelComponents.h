@@ -1,7 +1,8 @@
 // Independent reference for the tests: kappa-lambda-boundaries computed from voxel components
-// (paper §2.1.4) with Boost.Graph's connected_components on the voxel grid, never from surfel
-// adjacencies. The grid is the image domain padded by one voxel: outside voxels are 0-voxels,
-// all 6-connected through the padding frame, so the padding represents the whole outside.
+// (paper §2.1.4) with Boost's disjoint sets on the voxel grid, never from surfel adjacencies nor
+// from the engine's own code. The grid is the image domain padded by one voxel: outside voxels
+// are 0-voxels, all 6-connected through the padding frame, so the padding represents the whole
+// outside.
 #pragma once
 
 #include <algorithm>
@@ -10,8 +11,7 @@
 #include <set>
 #include <vector>
 
-#include <boost/graph/adjacency_list.hpp>
-#include <boost/graph/connected_components.hpp>
+#include <boost/pending/disjoint_sets.hpp>
 
 #include "AdjacencyPair.h"
 #include "Image.h"
@@ -30,7 +30,14 @@ class VoxelComponents {
     for (int z = -1; z <= dims_.nz; ++z)
       for (int y = -1; y <= dims_.ny; ++y)
         for (int x = -1; x <= dims_.nx; ++x) value_[id({x, y, z})] = image(x, y, z);
-    boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS> g(n);
+    // Iterator property maps, not pointers (nor disjoint_sets_with_storage, which uses them):
+    // where Boost's CSR graph is included, its boost::detail::get hides the boost::get of
+    // pointers.
+    std::vector<int> rank(n), parent(n);
+    const boost::typed_identity_property_map<int> index;
+    boost::disjoint_sets sets(boost::make_iterator_property_map(rank.begin(), index),
+                              boost::make_iterator_property_map(parent.begin(), index));
+    for (int i = 0; i < n; ++i) sets.make_set(i);
     for (int z = -1; z <= dims_.nz; ++z)
       for (int y = -1; y <= dims_.ny; ++y)
         for (int x = -1; x <= dims_.nx; ++x) {
@@ -41,13 +48,14 @@ class VoxelComponents {
                 const Voxel w = v + Voxel{dx, dy, dz};
                 if (!inPadded(w) || id(w) <= id(v) || value_[id(w)] != value_[id(v)]) continue;
                 const int adjacency = value_[id(v)] ? kappa(pair) : lambda(pair);
-                if (areAdjacent(adjacency, v, w)) boost::add_edge(id(v), id(w), g);
+                if (areAdjacent(adjacency, v, w)) sets.union_set(id(v), id(w));
               }
         }
     component_.resize(n);
-    boost::connected_components(g, component_.data());
+    for (int i = 0; i < n; ++i) component_[i] = sets.find_set(i);
   }
 
+  /// The same number for exactly the voxels of v's component (that of one of its voxels).
   int component(Voxel v) const { return component_[id(v)]; }
   bool value(Voxel v) const { return value_[id(v)]; }
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include <boost/range/iterator_range.hpp>
+
 #include "FindSeed.h"
 #include "TrackComponent.h"
 #include "VoxelComponents.h"

@@ -1,13 +1,15 @@
 // The scanning counterpart of tracking: enumerate every boundary surfel of the image (an
-// O(volume) scan) and split them into beta-components with a union-find over the same
-// adjacency. By Proposition 39 the components are exactly the kappa-lambda-boundaries.
+// O(volume) scan) and split them into beta-components with a union-find (Boost's disjoint sets)
+// over the same adjacency. By Proposition 39 the components are exactly the
+// kappa-lambda-boundaries.
 #pragma once
 
 #include <algorithm>
 #include <cstdint>
-#include <numeric>
 #include <unordered_map>
 #include <vector>
+
+#include <boost/pending/disjoint_sets.hpp>
 
 #include "AdjacencyPair.h"
 #include "BetaAdjacency.h"
@@ -55,27 +57,27 @@ BoundaryPartition scanBoundaries(const BinaryImage& image, AdjacencyPair pair) {
   indexOf.reserve(count);
   for (std::size_t i = 0; i < count; ++i) indexOf.emplace(result.surfels[i], std::uint32_t(i));
 
-  std::vector<std::uint32_t> parent(count);
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  // Boost's disjoint sets, as in converter/MeshComponents.h (the project's one union-find). The
+  // ranks and parents are iterator property maps, not pointers: where Boost's CSR graph is
+  // included (SurfaceGraph.h), its boost::detail::get hides the boost::get of pointers.
+  std::vector<std::uint32_t> rank(count), parent(count);
+  const boost::typed_identity_property_map<std::uint32_t> index;
+  boost::disjoint_sets sets(boost::make_iterator_property_map(rank.begin(), index),
+                            boost::make_iterator_property_map(parent.begin(), index));
+  for (std::uint32_t i = 0; i < count; ++i) sets.make_set(i);
   Surfel neighbours[kMaxBetaNeighbours];
   for (std::size_t i = 0; i < count; ++i) {
     const int k = betaNeighbours(image, result.surfels[i], pair, neighbours);
-    for (int j = 0; j < k; ++j) {
-      const std::uint32_t a = find(std::uint32_t(i)), b = find(indexOf.at(neighbours[j]));
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+    for (int j = 0; j < k; ++j) sets.union_set(std::uint32_t(i), indexOf.at(neighbours[j]));
   }
-  // Number components by their smallest surfel index.
+  // Number components by their smallest surfel index; `rank` is reused for the numbers.
+  constexpr std::uint32_t kUnnumbered = ~std::uint32_t(0);
+  std::fill(rank.begin(), rank.end(), kUnnumbered);
   result.component.assign(count, 0);
-  std::vector<std::uint32_t> label(count, ~0u);
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::uint32_t r = find(std::uint32_t(i));
-    if (label[r] == ~0u) label[r] = std::uint32_t(result.componentCount++);
-    result.component[i] = label[r];
+  for (std::uint32_t i = 0; i < count; ++i) {
+    std::uint32_t& number = rank[sets.find_set(i)];
+    if (number == kUnnumbered) number = std::uint32_t(result.componentCount++);
+    result.component[i] = number;
   }
   return result;
 }
