@@ -32,6 +32,7 @@ SeedRule seedRuleOf(const SurfaceOptions& o) {
     case SeedMode::All: return SeedRule::all();
     case SeedMode::Largest: return SeedRule::largest();
     case SeedMode::Voxel: return SeedRule::fromVoxel(o.seedVoxel);
+    case SeedMode::Ray: return SeedRule::ray(o.seedVoxel);
     case SeedMode::Point: return SeedRule::point(o.seedPoint);
     case SeedMode::Surfel: break;
   }
@@ -67,24 +68,26 @@ io::AnyVolume readInput(const InputOptions& input) {
 
 int extractionStages(const SurfaceOptions& o) { return o.seedMode == SeedMode::All ? 5 : 7; }
 
-void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extraction& x,
-                    StageClock& clock, Progress& progress, int stage, int stageCount) {
-  progress.stage(stage, stageCount, "checking values");
-  const VolumeStats stats = computeStats(volume);
-  x.dataMin = stats.min;
-  x.dataMax = stats.max;
-  x.pair = o.pair;
-  x.seedMode = o.seedMode;
+namespace {
+
+/// The values of `volume`, for Otsu's default or for an error message.
+VolumeStats valueStats(const io::AnyVolume& volume, const Extraction& x) {
+  VolumeStats stats = computeStats(volume);
   if (stats.voxels == 0)
     throw std::runtime_error("'" + x.input + "' holds no finite value: nothing to extract");
-  if (o.label) {
-    x.byLabel = true;
-    x.value = *o.label;
-    x.insideVoxels = countEqual(volume, x.value);
-    if (x.insideVoxels == 0) {
+  return stats;
+}
+
+/// After the front door found no surface: the message, made precise by the data's values (an
+/// O(volume) pass, paid only on this error path and by Otsu's default).
+[[noreturn]] void explainNoSurface(const io::AnyVolume& volume, const Extraction& x,
+                                   const std::string& message) {
+  const VolumeStats stats = valueStats(volume, x);
+  const std::string range = "[" + formatNumber(stats.min) + ", " + formatNumber(stats.max) + "]";
+  if (x.byLabel) {
+    if (countEqual(volume, x.value) == 0) {
       std::ostringstream msg;
-      msg << "empty selection: label " << formatNumber(x.value) << " does not occur in '" << x.input
-          << "'";
+      msg << "empty selection: label " << formatNumber(x.value) << " does not occur in '" << x.input << "'";
       if (!stats.labels.empty()) {
         msg << " (labels present: ";
         std::size_t shown = 0;
@@ -97,24 +100,59 @@ void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extrac
         }
         msg << ")";
       } else {
-        msg << " (values in [" << formatNumber(stats.min) << ", " << formatNumber(stats.max) << "])";
+        msg << " (values in " << range << ")";
       }
       throw std::runtime_error(msg.str());
     }
   } else {
-    x.value = o.iso ? *o.iso : stats.otsu;
-    x.valueFromOtsu = !o.iso;
-    const std::string range = "[" + formatNumber(stats.min) + ", " + formatNumber(stats.max) + "]";
     if (stats.min == stats.max)
-      throw std::runtime_error("'" + x.input + "' is constant (every voxel is " +
-                               formatNumber(stats.min) + "): there is no surface to extract");
+      throw std::runtime_error("'" + x.input + "' is constant (every voxel is " + formatNumber(stats.min) +
+                               "): there is no surface to extract");
     if (x.value < stats.min)
-      throw std::runtime_error("iso-value " + formatNumber(x.value) + " is outside the data range " +
-                               range + " of '" + x.input + "': every voxel would be inside");
+      throw std::runtime_error("iso-value " + formatNumber(x.value) + " is outside the data range " + range +
+                               " of '" + x.input + "': every voxel would be inside");
     if (x.value >= stats.max)
-      throw std::runtime_error("iso-value " + formatNumber(x.value) + " is outside the data range " +
-                               range + " of '" + x.input + "': no voxel is above it");
-    x.insideVoxels = countAbove(volume, x.value);
+      throw std::runtime_error("iso-value " + formatNumber(x.value) + " is outside the data range " + range +
+                               " of '" + x.input + "': no voxel is above it");
+  }
+  throw std::runtime_error(message);
+}
+
+}  // namespace
+
+void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extraction& x,
+                    StageClock& clock, Progress& progress, int stage, int stageCount) {
+  progress.stage(stage, stageCount, "choosing the voxels");
+  x.pair = o.pair;
+  x.seedMode = o.seedMode;
+  x.byLabel = o.label.has_value();
+  if (o.label) {
+    x.value = *o.label;
+  } else if (o.iso) {
+    x.value = *o.iso;
+    // The scanning rules read every voxel anyway: one more pass checks the iso-value against
+    // the data range (a seeded extraction leaves that to its seed rule's own error).
+    if (o.seedMode == SeedMode::Largest || o.seedMode == SeedMode::All) {
+      const auto range = valueRange(volume);
+      if (!range) throw std::runtime_error("'" + x.input + "' holds no finite value: nothing to extract");
+      x.dataRange = range;
+      const std::string text = "[" + formatNumber((*range)[0]) + ", " + formatNumber((*range)[1]) + "]";
+      if (x.value < (*range)[0])
+        throw std::runtime_error("iso-value " + formatNumber(x.value) + " is outside the data range " + text +
+                                 " of '" + x.input + "': every voxel would be inside");
+      if (x.value >= (*range)[1])
+        throw std::runtime_error("iso-value " + formatNumber(x.value) + " is outside the data range " + text +
+                                 " of '" + x.input + "': no voxel is above it");
+    }
+  } else {
+    // Otsu's threshold is the one default that needs every value.
+    const VolumeStats stats = valueStats(volume, x);
+    if (stats.min == stats.max)
+      throw std::runtime_error("'" + x.input + "' is constant (every voxel is " + formatNumber(stats.min) +
+                               "): there is no surface to extract");
+    x.dataRange = {stats.min, stats.max};
+    x.value = stats.otsu;
+    x.valueFromOtsu = true;
   }
   clock.lap(x.timings, "values");
 
@@ -122,6 +160,7 @@ void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extrac
   eo.selection = x.byLabel ? Selection::label(x.value) : Selection::threshold(x.value);
   eo.seed = seedRuleOf(o);
   eo.pair = o.pair;
+  eo.threads = o.threads;
   eo.mapping = o.mapping == MappingMode::Midpoint ? Mapping::Midpoint
                : o.mapping == MappingMode::Linear ? Mapping::Linear
                                                   : Mapping::Default;
@@ -130,7 +169,14 @@ void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extrac
     else progress.stage(stage + 1 + e.index, stageCount, stageText(e.stage));
   };
   if (o.seedMode == SeedMode::Point) x.seedPoint = o.seedPoint;
-  Surface surface = extract(viewOf(volume), eo);
+  Surface surface;
+  try {
+    surface = extract(viewOf(volume), eo);
+  } catch (const InvalidInput& e) {
+    explainNoSurface(volume, x, e.what());
+  }
+  x.warnings = surface.warnings;
+  x.seedDistance = surface.seed.distance;
   for (const StageTime& t : surface.timings) x.timings.push_back({t.stage, t.seconds});
   clock.skip();  // the core timed its own stages
   x.mapping = toString(surface.mapping);

@@ -50,13 +50,14 @@ struct Extraction {
   Dims dims;
   io::ScalarType type = io::ScalarType::UInt8;
   ImageGeometry geometry;
-  double dataMin = 0, dataMax = 0;
+  /// The data range, when it was computed (Otsu's default); a seeded extraction never reads
+  /// every voxel to find it.
+  std::optional<std::array<double, 2>> dataRange;
 
   // The binary image and the surface options.
   bool byLabel = false;
   double value = 0;               ///< the iso-value or the label
   bool valueFromOtsu = false;     ///< no --iso / --label: Otsu's threshold was used
-  std::size_t insideVoxels = 0;   ///< 1-voxels in the domain
   AdjacencyPair pair = AdjacencyPair::k26_6;
   std::string mapping;            ///< "linear" or "midpoint"
 
@@ -65,12 +66,14 @@ struct Extraction {
   std::optional<std::array<double, 3>> seedPoint;  ///< --seed-point, physical
   std::optional<Voxel> seedVoxel;                  ///< --seed, or the voxel of --seed-point
   bool seedVoxelInside = false;                    ///< the seed voxel is a 1-voxel
+  std::optional<double> seedDistance;              ///< nearest-surfel rule: physical distance
   std::optional<Direction> walkDirection;          ///< the ray that found the surfel
   int walkSteps = 0;                               ///< voxels walked along it
   std::optional<Surfel> seedSurfel;                ///< the surfel tracking started from
   std::size_t boundaries = 0;                      ///< --largest / --all: boundaries in the image
 
   // The result.
+  std::vector<std::string> warnings;  ///< printed on stderr (e.g. a speck)
   std::size_t surfels = 0;
   SurfaceMesh mesh;
   MeshStats stats;

@@ -33,6 +33,8 @@ int runMesh(const std::vector<std::string>& args) {
   clock.lap(x.timings, "write");
   x.totalSeconds = clock.total();
   progress.finish();
+  if (!o.out.quiet)
+    for (const std::string& w : x.warnings) std::cerr << "surftrack: warning: " << w << "\n";
 
   if (o.out.json) {
     std::cout << jsonText(extractionJson(x)) << std::endl;

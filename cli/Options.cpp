@@ -405,21 +405,35 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                               o.surface.seedDirection = *parseDirection(parts[3]);
                             }
                           },
-                          "voxel x,y,z: the boundary first met walking from it along +x (then -x,\n"
-                          "+y, -y, +z, -z); the surfel used is printed. x,y,z,DIR: the boundary of\n"
-                          "surfel (c=(x,y,z), d=c+DIR), DIR one of +x -x +y -y +z -z")
+                          "voxel x,y,z: the boundary of the surfel nearest the voxel's centre\n"
+                          "(its own face if it is on a boundary); the surfel and its distance are\n"
+                          "printed. x,y,z,DIR: the boundary of surfel (c=(x,y,z), d=c+DIR), DIR one\n"
+                          "of +x -x +y -y +z -z")
                           ->check(kSeed)
                           ->group(which);
+  CLI::Option* seedRay = addValue(
+                             app, "--seed-ray", "x,y,z",
+                             [&o](const std::string& s) {
+                               const auto parts = splitCommas(s);
+                               o.surface.seedVoxel = Voxel{int(*toInteger(parts[0])), int(*toInteger(parts[1])),
+                                                           int(*toInteger(parts[2]))};
+                               o.surface.seedMode = SeedMode::Ray;
+                             },
+                             "the boundary first met walking from voxel x,y,z along +x (then -x,\n"
+                             "+y, -y, +z, -z)")
+                             ->check(tripleOf({kInteger}, "expected three integers x,y,z"))
+                             ->group(which);
   CLI::Option* seedPoint = addValue(
                                app, "--seed-point", "X,Y,Z",
                                [&o](const std::string& s) {
                                  o.surface.seedPoint = toTriple(s);
                                  o.surface.seedMode = SeedMode::Point;
                                },
-                               "like --seed x,y,z, from the voxel nearest to a physical point")
+                               "the boundary of the surfel nearest a physical point (as VTK's\n"
+                               "closest-point region)")
                                ->check(tripleOf({kNumber}, "expected three numbers X,Y,Z"))
                                ->group(which);
-  a.seedRules = {seed, seedPoint, a.largest, a.all};
+  a.seedRules = {seed, seedRay, seedPoint, a.largest, a.all};
 
   addValue(
       app, "-a,--adjacency", "K-L", [&o](const std::string& s) { o.surface.pair = parseAdjacencyPair(s); },
@@ -436,6 +450,13 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                       [](const std::string& s) { return "expected midpoint or linear, got '" + s + "'"; }))
                   ->group("surface options");
   app.add_flag("--ascii", o.ascii, "text PLY / STL")->group("surface options");
+  app.add_option("--threads", o.surface.threads, "threads for the scan of --largest / --all (default 0: all\n"
+                 "cores); the mesh is the same for any number")
+      ->option_text("N")
+      ->check(explained(CLI::Range(0, 1024), [](const std::string& s) {
+        return "--threads takes a number of threads from 0 (all cores) to 1024, got '" + s + "'";
+      }))
+      ->group("surface options");
 
   a.input = addInputOptions(app, o.input);
   addOutputOptions(app, o.out);
@@ -523,7 +544,7 @@ MeshOptions parseMeshOptions(const std::vector<std::string>& args) {
     if (std::find(a.seedRules.begin(), a.seedRules.end(), opt) != a.seedRules.end())
       rules.push_back(opt->get_name());
   if (rules.size() > 1)
-    throw UsageError("give only one of --seed, --seed-point, --largest, --all (got " + rules[0] + " and " +
+    throw UsageError("give only one of --seed, --seed-ray, --seed-point, --largest, --all (got " + rules[0] + " and " +
                      rules[1] + ")");
   if (a.largest->count()) o.surface.seedMode = SeedMode::Largest;
   if (a.all->count()) o.surface.seedMode = SeedMode::All;

@@ -35,7 +35,7 @@ struct InputOptions {
   std::optional<std::array<double, 3>> origin;   ///< --origin
 };
 
-enum class SeedMode { Largest, All, Voxel, Surfel, Point };
+enum class SeedMode { Largest, All, Voxel, Ray, Surfel, Point };
 enum class MappingMode { Default, Midpoint, Linear };
 
 /// What surface to extract: a threshold or a label, a seed rule, a pair, a mapping.
@@ -43,11 +43,12 @@ struct SurfaceOptions {
   std::optional<double> iso;     ///< --iso S: 1-voxels are f > S
   std::optional<double> label;   ///< --label L: 1-voxels are f = L
   SeedMode seedMode = SeedMode::Largest;
-  Voxel seedVoxel;               ///< --seed x,y,z (SeedMode::Voxel) or the c of --seed x,y,z,DIR
+  Voxel seedVoxel;               ///< --seed x,y,z (Voxel), --seed-ray x,y,z (Ray) or the c of --seed x,y,z,DIR
   Direction seedDirection = 0;   ///< the DIR of --seed x,y,z,DIR (SeedMode::Surfel)
   std::array<double, 3> seedPoint{};  ///< --seed-point X,Y,Z (physical coordinates)
   AdjacencyPair pair = AdjacencyPair::k26_6;
   MappingMode mapping = MappingMode::Default;
+  int threads = 0;               ///< --threads N (0: all cores)
 };
 
 struct OutputOptions {

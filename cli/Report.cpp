@@ -96,7 +96,13 @@ std::string seedText(const Extraction& x) {
       break;
     case SeedMode::Voxel:
     case SeedMode::Point:
-      if (x.seedPoint) s << "point " << tripleText(*x.seedPoint) << " -> ";
+      if (x.seedPoint) s << "point " << tripleText(*x.seedPoint);
+      if (x.seedVoxel)
+        s << "voxel " << voxelText(*x.seedVoxel) << " (" << (x.seedVoxelInside ? "inside" : "outside") << ")";
+      s << " -> nearest surfel " << surfelText(*x.seedSurfel);
+      if (x.seedDistance) s << ", at " << num(*x.seedDistance) << " (physical units)";
+      break;
+    case SeedMode::Ray:
       if (x.seedVoxel)
         s << "voxel " << voxelText(*x.seedVoxel) << " (" << (x.seedVoxelInside ? "inside" : "outside")
           << "), ";
@@ -123,6 +129,7 @@ const char* seedModeName(SeedMode m) {
     case SeedMode::Largest: return "largest";
     case SeedMode::All: return "all";
     case SeedMode::Voxel: return "voxel";
+    case SeedMode::Ray: return "ray";
     case SeedMode::Surfel: return "surfel";
     case SeedMode::Point: return "point";
   }
@@ -156,10 +163,10 @@ void printSummary(std::ostream& out, const Extraction& x) {
   row(out, "image", imageLine(x.dims, x.type, x.geometry));
   {
     std::ostringstream s;
-    s << "range [" << num(x.dataMin) << ", " << num(x.dataMax) << "]; inside: f ";
+    if (x.dataRange) s << "range [" << num((*x.dataRange)[0]) << ", " << num((*x.dataRange)[1]) << "]; ";
+    s << "inside: f ";
     if (x.byLabel) s << "= " << num(x.value, 10) << " (label)";
     else s << "> " << num(x.value, 10) << (x.valueFromOtsu ? " (Otsu's threshold; set it with --iso)" : "");
-    s << ", " << x.insideVoxels << " voxels";
     row(out, "values", s.str());
   }
   row(out, "surface", "adjacency " + toString(x.pair) + " (1-voxels " + std::to_string(kappa(x.pair)) +
@@ -219,12 +226,11 @@ json extractionJson(const Extraction& x) {
   j["spacing"] = numbers(x.geometry.spacing);
   j["origin"] = numbers(x.geometry.origin);
   j["direction"] = directionJson(x.geometry);
-  j["data_range"] = {number(x.dataMin), number(x.dataMax)};
+  if (x.dataRange) j["data_range"] = {number((*x.dataRange)[0]), number((*x.dataRange)[1])};
   json selection;
   selection["mode"] = x.byLabel ? "label" : "iso";
   selection[x.byLabel ? "label" : "iso"] = number(x.value);
   if (!x.byLabel) selection["iso_source"] = x.valueFromOtsu ? "otsu" : "given";
-  selection["inside_voxels"] = x.insideVoxels;
   j["selection"] = std::move(selection);
   j["adjacency"] = toString(x.pair);
   j["mapping"] = x.mapping;
@@ -235,6 +241,7 @@ json extractionJson(const Extraction& x) {
     seed["voxel"] = voxelJson(*x.seedVoxel);
     seed["voxel_inside"] = x.seedVoxelInside;
   }
+  if (x.seedDistance) seed["distance"] = number(*x.seedDistance);
   if (x.walkDirection) {
     seed["walk_direction"] = directionName(*x.walkDirection);
     seed["walk_steps"] = x.walkSteps;
@@ -281,6 +288,7 @@ json extractionJson(const Extraction& x) {
   for (const auto& t : x.timings) timings[t.name] = number(t.seconds);
   timings["total"] = number(x.totalSeconds);
   j["timings_s"] = std::move(timings);
+  j["warnings"] = x.warnings;
   return j;
 }
 

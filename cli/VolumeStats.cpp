@@ -113,6 +113,23 @@ double VolumeStats::quantile(double q) const {
   return max;
 }
 
+std::optional<std::array<double, 2>> valueRange(const io::AnyVolume& volume) {
+  return std::visit(
+      [](const auto& image) -> std::optional<std::array<double, 2>> {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (auto v : image.data()) {
+          const double d = double(v);
+          if (std::isfinite(d)) {  // (NaN fails both comparisons below as well)
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
+          }
+        }
+        if (lo > hi) return std::nullopt;
+        return std::array<double, 2>{lo, hi};
+      },
+      volume);
+}
+
 VolumeStats computeStats(const io::AnyVolume& volume) {
   return std::visit([](const auto& image) { return statsOf(image); }, volume);
 }

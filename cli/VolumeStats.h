@@ -2,7 +2,9 @@
 // iso-value), the labels of an integer image with few distinct values.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <optional>
 #include <cstdint>
 #include <vector>
 
@@ -27,6 +29,9 @@ struct VolumeStats {
 };
 
 VolumeStats computeStats(const io::AnyVolume& volume);
+
+/// The smallest and largest finite values (one pass), or nothing if no value is finite.
+std::optional<std::array<double, 2>> valueRange(const io::AnyVolume& volume);
 
 /// The number of voxels with f > s, and with f = label.
 std::size_t countAbove(const io::AnyVolume& volume, double s);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "Phantoms.h"
 #include "cli/CliTestSupport.h"
 
 namespace surftrack {
@@ -76,16 +77,10 @@ DenseImage<T> boxVolume(Dims dims, Voxel lo, Voxel hi, T in, T out, ImageGeometr
   return image;
 }
 
-/// Adds a ball of value `in`, radius r (voxels with |v - c|^2 <= r^2).
+/// Adds a ball of value `in`, radius r (voxels with |v - c|^2 <= r^2; lib/Phantoms.h).
 template <class T>
 void addBall(DenseImage<T>& image, Voxel c, int r, T in) {
-  const Dims& d = image.dims();
-  for (int z = 0; z < d.nz; ++z)
-    for (int y = 0; y < d.ny; ++y)
-      for (int x = 0; x < d.nx; ++x) {
-        const int dx = x - c.x, dy = y - c.y, dz = z - c.z;
-        if (dx * dx + dy * dy + dz * dz <= r * r) image.at(x, y, z) = in;
-      }
+  paintBall(image, Ball::ofRadius(c, r), in);
 }
 
 template <class T>
@@ -295,39 +290,66 @@ class CliSeeds : public Cli {
   std::string input_;
 };
 
-TEST_F(CliSeeds, VoxelInsideWalksPlusXToTheFirstSurfel) {
-  RunResult r = mesh({"--seed", "26,10,10", "--json"});
+TEST_F(CliSeeds, RayFromAVoxelInsideWalksPlusXToTheFirstSurfel) {
+  RunResult r = mesh({"--seed-ray", "26,10,10", "--json"});
   expectGoodMesh(r, path("out.ply"), surfelsB_, std::nullopt);
   EXPECT_EQ(jsonString(r.out, "walk_direction"), "+x");
   EXPECT_EQ(jsonNumber(r.out, "walk_steps"), 4.0);
   EXPECT_EQ(jsonBool(r.out, "voxel_inside"), std::optional<bool>(true));
   // The summary names the surfel used.
-  r = mesh({"--seed", "26,10,10"}, "out2.ply");
+  r = mesh({"--seed-ray", "26,10,10"}, "out2.ply");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("voxel (26,10,10) (inside), 4 voxels along +x to surfel c=(30,10,10) d=(31,10,10)"),
             std::string::npos)
       << r.out;
 }
 
-TEST_F(CliSeeds, VoxelOutsideWalksToTheFirstInsideVoxel) {
-  const RunResult r = mesh({"--seed", "18,10,10", "--json"});
+TEST_F(CliSeeds, RayFromAVoxelOutsideWalksToTheFirstInsideVoxel) {
+  const RunResult r = mesh({"--seed-ray", "18,10,10", "--json"});
   expectGoodMesh(r, path("out.ply"), surfelsB_, std::nullopt);
   EXPECT_EQ(jsonBool(r.out, "voxel_inside"), std::optional<bool>(false));
   EXPECT_EQ(jsonArray(r.out, "c"), "22,10,10") << r.out;
   EXPECT_EQ(jsonArray(r.out, "d"), "21,10,10") << r.out;
   // From (0,0,0), +x meets nothing, -x leaves the domain at once, +y ... : no ray reaches a
   // ball, but from (10,0,10) the +y ray (second try after +x, -x) reaches A.
-  const RunResult r2 = mesh({"--seed", "10,0,10", "--json"}, "out2.ply");
+  const RunResult r2 = mesh({"--seed-ray", "10,0,10", "--json"}, "out2.ply");
   expectGoodMesh(r2, path("out2.ply"), surfelsA_, std::nullopt);
   EXPECT_EQ(jsonString(r2.out, "walk_direction"), "+y");
 }
 
-TEST_F(CliSeeds, PhysicalPointGoesToTheNearestVoxel) {
-  // Voxel (10,10,10) is at (-5 + 2*10, 3 + 10, 7 + 10) = (15, 13, 17).
-  const RunResult r = mesh({"--seed-point", "15.4,13.2,16.8", "--json"});
+TEST_F(CliSeeds, ASeedVoxelOrPointGoesToTheNearestSurfel) {
+  // Voxel (19,10,10), between A (x <= 16) and B (x >= 22), is nearer A's surfel c=(16,10,10)
+  // d=(17,10,10), whose midpoint x = 16.5 is 2.5 voxels = 5 mm away (spacing 2 along x), than
+  // B's (21.5: 5 mm too, but B's y/z-neighbours are no nearer; ties go to the smaller key: A).
+  RunResult r = mesh({"--seed", "19,10,10", "--json"});
   expectGoodMesh(r, path("out.ply"), surfelsA_, std::nullopt);
-  EXPECT_EQ(jsonArray(r.out, "voxel"), "10,10,10") << r.out;
-  EXPECT_EQ(jsonArray(r.out, "point"), "15.4,13.2,16.8") << r.out;
+  EXPECT_EQ(jsonArray(r.out, "c"), "16,10,10") << r.out;
+  EXPECT_EQ(jsonNumber(r.out, "distance"), 5.0) << r.out;
+  // Nearer B: x = 20.
+  r = mesh({"--seed", "20,10,10", "--json"}, "b.ply");
+  expectGoodMesh(r, path("b.ply"), surfelsB_, std::nullopt);
+  EXPECT_EQ(jsonNumber(r.out, "distance"), 3.0) << r.out;
+  // The midpoint of a surfel of A, given as a physical point: that surfel, at distance 0
+  // (the ray rule used to round it to the outside voxel and walk away from A).
+  // Surfel c=(16,10,10) d=(17,10,10): midpoint x = 16.5 -> (-5 + 33, 13, 17) = (28, 13, 17).
+  r = mesh({"--seed-point", "28,13,17", "--json"}, "p.ply");
+  expectGoodMesh(r, path("p.ply"), surfelsA_, std::nullopt);
+  EXPECT_EQ(jsonNumber(r.out, "distance"), 0.0) << r.out;
+  EXPECT_EQ(jsonArray(r.out, "point"), "28,13,17") << r.out;
+  r = mesh({"--seed", "19,10,10"}, "s.ply");
+  EXPECT_NE(r.out.find("-> nearest surfel c=(16,10,10) d=(17,10,10), at 5"), std::string::npos) << r.out;
+}
+
+TEST_F(CliSeeds, ASpeckGivesAWarning) {
+  DenseImage<std::uint8_t> image = image_;
+  image.at(33, 2, 2) = 200;  // one voxel of noise
+  io::writeVolume(io::AnyVolume(image), path("speck.nrrd"));
+  RunResult r = run({"mesh", path("speck.nrrd"), "-o", path("s.ply"), "--iso", "100", "--seed", "33,2,2"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("surftrack: warning: the surface found is a speck: 6 surfels"), std::string::npos) << r.err;
+  r = run({"mesh", path("speck.nrrd"), "-o", path("s.ply"), "--iso", "100", "--seed", "10,10,10"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
 }
 
 TEST_F(CliSeeds, SurfelLargestAndAll) {
@@ -587,8 +609,10 @@ TEST_F(CliErrors, SeedOutsideTheDomain) {
 
 TEST_F(CliErrors, SeedNotOnAnyBoundary) {
   // The ball occupies [2, 6]^3: no axis ray from (12,12,12) meets it.
-  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "12,12,12"}, 1,
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed-ray", "12,12,12"}, 1,
                 "seed voxel (12,12,12) is not on any boundary");
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "250", "--seed", "12,12,12"}, 1,
+                "no voxel is above it");
   expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "12,12,12,+y"}, 1,
                 "is not a boundary surfel");
   expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "4,4,4,+x"}, 1,

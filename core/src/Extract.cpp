@@ -247,6 +247,16 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
         }
         const std::string what = "seed point (" + numberText(o.seed.physical[0]) + "," +
                                  numberText(o.seed.physical[1]) + "," + numberText(o.seed.physical[2]) + ")";
+        // A point off the image is most often a point in another frame (RAS for LPS, mm for
+        // voxels): say so rather than take the nearest surfel of the image's border.
+        for (int a = 0; a < 3; ++a)
+          if (!(index[a] >= -0.5 && index[a] <= binary.dims()[a] - 0.5)) {
+            std::ostringstream msg;
+            msg << what << " lies outside the image: its voxel index (" << numberText(index[0]) << ","
+                << numberText(index[1]) << "," << numberText(index[2]) << ") is outside the domain "
+                << domainText(binary.dims());
+            throw InvalidInput(msg.str());
+          }
         seed = resolveNearestSeed(binary, index, geometry, what, out.seed);
         break;
       }
