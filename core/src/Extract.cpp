@@ -197,7 +197,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
     throw InvalidInput("epsilon " + numberText(o.epsilon) + " is outside ]0, 0.5[");
 
   const bool scanning = o.seed.kind == Kind::All;
-  Stages stages(o, scanning ? 3 : 5, out);
+  Stages stages(o, scanning ? 3 : 5, out);  // (the last, "figures", is empty without figures)
   const SourceImage binary(source, o.selection);
   const ImageGeometry geometry = source.geometry();
   TriangleMesh mesh;
@@ -291,7 +291,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
     for (auto& t : out.triangles) std::swap(t[1], t[2]);
 
   stages.begin("figures");
-  out.components = componentFigures(out.vertices, out.triangles);
+  if (o.figures) out.components = componentFigures(out.vertices, out.triangles);
   if (scanning) out.boundariesInImage = out.components.size();
   for (const ComponentFigures& c : out.components) out.euler += c.euler;
   stages.end();

@@ -80,7 +80,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
                       double value, const std::string& seedKind, std::array<double, 6> seed,
                       const std::string& adjacency, const std::string& mapping, double epsilon,
                       std::array<double, 3> spacing, std::array<double, 3> origin,
-                      std::array<std::array<double, 3>, 3> direction, int threads,
+                      std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
                       py::object progress) {
   if (volume.ndim() != 3)
     throw py::value_error("the volume must be 3-D, not " + std::to_string(volume.ndim()) + "-D");
@@ -107,6 +107,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
   o.mapping = parseMapping(mapping);
   o.epsilon = epsilon;
   o.threads = threads;
+  o.figures = figures;
   auto engineVoxel = [&](int first) {
     Voxel v;
     for (int e = 0; e < 3; ++e) v[e] = int(seed[first + order[e]]);
@@ -145,17 +146,17 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
   // (A surface is never empty: extract() throws instead.)
   py::array vertices = viewOf(const_cast<double*>(s.vertices.front().data()), {n, 3}, r);
   py::array faces = viewOf(const_cast<std::uint32_t*>(s.triangles.front().data()), {m, 3}, r);
-  py::list components;
-  for (const ComponentFigures& c : s.components) {
-    py::dict d;
-    d["surfels"] = c.surfels;
-    d["triangles"] = c.triangles;
-    d["edges"] = c.edges;
-    d["euler"] = c.euler;
-    d["genus"] = c.genus();
-    d["area"] = c.area;
-    d["volume"] = c.volume;
-    components.append(d);
+  // The figures as one (K, 7) array (a dict per component would cost more than the scan on
+  // images with millions of noise specks); the Python layer makes dicts on first use.
+  py::array_t<double> components({py::ssize_t(s.components.size()), py::ssize_t(7)});
+  {
+    auto c = components.mutable_unchecked<2>();
+    for (py::ssize_t i = 0; i < py::ssize_t(s.components.size()); ++i) {
+      const ComponentFigures& f = s.components[std::size_t(i)];
+      const double row[7] = {double(f.surfels), double(f.triangles), double(f.edges), double(f.euler),
+                             f.genus(), f.area, f.volume};
+      for (int k = 0; k < 7; ++k) c(i, k) = row[k];
+    }
   }
   py::dict timings;
   for (const StageTime& t : s.timings) timings[py::str(t.stage)] = t.seconds;

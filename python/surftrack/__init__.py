@@ -48,7 +48,7 @@ class Surface:
         self._result = result
         self._normals = normals
         self._surfels = surfels
-        self.components = list(components)
+        self._components = components
         self.euler = euler
         self.boundaries_in_image = boundaries_in_image
         self.mapping = mapping
@@ -69,6 +69,17 @@ class Surface:
         if self._surfels is None:
             self._surfels = self._result.surfels()
         return self._surfels
+
+    _FIGURES = ("surfels", "triangles", "edges", "euler", "genus", "area", "volume")
+
+    @property
+    def components(self) -> list:
+        if not isinstance(self._components, list):
+            table = np.asarray(self._components).reshape(-1, len(self._FIGURES))
+            self._components = [
+                {k: (int(v) if k in ("surfels", "triangles", "edges", "euler") else float(v))
+                 for k, v in zip(self._FIGURES, row)} for row in table]
+        return self._components
 
     @property
     def genus(self) -> float:
@@ -132,7 +143,7 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
             mode: str = "seed", seed_rule: str = "nearest", adjacency: str = "26-6",
             mapping: str = "default",
             spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, affine=None,
-            epsilon: float = 1e-3, threads: int = 0,
+            epsilon: float = 1e-3, threads: int = 0, figures: bool = True,
             progress: Optional[Callable[[str, int, int, int], None]] = None) -> Surface:
     """The surface of one boundary (mode="seed"), of the largest, or of all boundaries.
 
@@ -144,7 +155,8 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     vertex on its surfel's segment: "linear" (iso-value interpolation, the default for a
     level), "midpoint" (the default for a label). ``progress(stage, index, stages, surfels)``
     is called at each stage and while tracking. ``threads`` (0: all cores) runs the scan of
-    "largest" and "all" in parallel; the surface is the same for any number. ``affine`` (a 4x4 voxel-to-world matrix, as
+    "largest" and "all" in parallel; the surface is the same for any number. ``figures=False``
+    skips the per-component figures (``components`` empty, ``euler`` 0). ``affine`` (a 4x4 voxel-to-world matrix, as
     nibabel's ``img.affine``) replaces spacing, origin and direction. Raises ValueError /
     TypeError on bad input.
     """
@@ -209,7 +221,8 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     try:
         out = _surftrack.extract_array(array, order, kind, value, seed_kind, seed_values,
                                        adjacency, mapping, float(epsilon), spacing, origin,
-                                       direction.tolist(), int(threads), progress)
+                                       direction.tolist(), int(threads), bool(figures),
+                                       progress)
     except ValueError as error:
         note = _range_note(array, value) if kind == "threshold" else ""
         raise ValueError(f"{error}{note}") from None
@@ -242,7 +255,7 @@ def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_dire
     if mask is not None:
         raise ValueError("mask is not supported by surftrack.marching_cubes")
     surface = extract(array, level=level, mode="all", adjacency=adjacency, mapping="linear",
-                      spacing=spacing, epsilon=1e-9)
+                      spacing=spacing, epsilon=1e-9, figures=False)
     verts = surface.vertices.astype(np.float32)
     faces = surface.faces.astype(np.int32)
     normals = surface.normals.astype(np.float32)

@@ -84,6 +84,9 @@ struct ExtractOptions {
   /// Threads for the scanning method (largest, all): 0 for all cores. The surface is the same
   /// for any number. The source is then read from several threads at once.
   int threads = 0;
+  /// Per-component figures (a union-find over the vertices): off, `components` stays empty,
+  /// `euler` 0 and, for `all`, `boundariesInImage` 0 — for callers that need only the mesh.
+  bool figures = true;
 };
 
 /// The figures of one connected component (one kappa-lambda-boundary, Proposition 39).
