@@ -281,7 +281,7 @@ Row measure(const Options& o, int q, double noise) {
   // Reference run (also the warm-up): the equality check comes before any timing.
   std::fprintf(stderr, "[%s] checking method 2 against method 1b...\n", tag);
   {
-    TriangleMesh whole = scanIsoSurface(image, o.pair);
+    TriangleMesh whole = scanIsoSurface(image, o.pair, 1);
     row.allSurfels = whole.surfels.size();
     row.allTriangles = whole.triangles.size();
     meshComponents(whole, row.components);
@@ -326,7 +326,7 @@ Row measure(const Options& o, int q, double noise) {
   for (int r = 0; r < row.runs; ++r) {
     {
       const Instant t0 = now();
-      TriangleMesh whole = scanIsoSurface(image, o.pair);
+      TriangleMesh whole = scanIsoSurface(image, o.pair, 1);
       const Instant t1 = now();
       TriangleMesh component = extractComponent(whole, seed);
       const Instant t2 = now();
@@ -338,7 +338,7 @@ Row measure(const Options& o, int q, double noise) {
     }
     if (o.generic) {
       const Instant t0 = now();
-      TriangleMesh whole = scanIsoSurfaceGeneric(image, o.pair);
+      TriangleMesh whole = scanIsoSurfaceGeneric(image, o.pair, 1);
       const Instant t1 = now();
       sink += whole.triangles.size();
       row.generic.add(between(t0, t1));

@@ -159,14 +159,14 @@ int main(int argc, char** argv) try {
 
       std::size_t surfels = 0, triangles = 0, components = 0;
       {
-        const TriangleMesh mesh = scanIsoSurface(image, o.pair);
+        const TriangleMesh mesh = scanIsoSurface(image, o.pair, 1);
         surfels = mesh.surfels.size();
         triangles = mesh.triangles.size();
         meshComponents(mesh, components);
       }
-      const double scan = bench::medianSeconds(o.runs, [&] { return scanIsoSurface(image, o.pair); }, clock);
+      const double scan = bench::medianSeconds(o.runs, [&] { return scanIsoSurface(image, o.pair, 1); }, clock);
       const double generic = o.generic ? bench::medianSeconds(o.runs, [&] {
-        return scanIsoSurfaceGeneric(image, o.pair);
+        return scanIsoSurfaceGeneric(image, o.pair, 1);
       }, clock) : 0.0;
       const ClassicMarchingCubes classic(sphere.image, std::uint8_t(bench::kSphereIsoValue));
       {
@@ -176,7 +176,7 @@ int main(int argc, char** argv) try {
       }
       const double mc = bench::medianSeconds(o.runs, [&] { return classic.run(o.pair); }, clock);
       const double oneB = bench::medianSeconds(o.runs, [&] {
-        return extractComponent(scanIsoSurface(image, o.pair), seed);
+        return extractComponent(scanIsoSurface(image, o.pair, 1), seed);
       }, clock);
       std::printf("%5d %5.0f%% %10zu %10zu %7zu | %9.2f %12.4g | %9.2f %12.4g | %9.2f %12.4g | %9.2f\n",
                   q, 100 * noise, surfels, triangles, components, 1e3 * scan, voxels / scan,
