@@ -17,7 +17,7 @@
 #include "BenchSupport.h"
 #include "BoundaryMapping.h"
 #include "LoopExtraction.h"
-#include "SphereImage.h"
+#include "Phantoms.h"
 #include "SurfaceMesh.h"
 #include "TrackComponent.h"
 
@@ -50,9 +50,9 @@ int main(int argc, char** argv) {
                 "loops", "M tri/s", "loops(image)", "M tri/s", "mapping", "openmesh", "M tri/s");
     for (int q : sizes)
       for (double noise : {0.0, 0.01, 0.05}) {
-        const bench::NoisySphere sphere = bench::makeNoisySphere(q, noise);
+        const NoisyPhantom sphere = makeNoisySphere(q, noise);
         const auto image = sphere.binary();
-        const Surfel seed = bench::protocolSeed(sphere);
+        const Surfel seed = protocolSeed(sphere);
         SurfaceGraph graph;
         const double track = bench::medianSeconds(reps, [&] { graph = trackComponent(image, seed, pair); });
         TriangleMesh mesh;
@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
         mesh = extractLoops(graph);
         if (extractLoops(image, graph).triangles != mesh.triangles)
           throw std::logic_error("the two extractLoops overloads disagree");
-        const IsoValueMapping<std::uint8_t> mapping(sphere.image, bench::kSphereIsoValue);
+        const IsoValueMapping<std::uint8_t> mapping(sphere.image, kPhantomIsoValue);
         std::vector<std::array<double, 3>> points;
         const double map = bench::medianSeconds(reps, [&] { points = mapVertices(mesh, mapping, {}); });
         const double build = bench::medianSeconds(reps, [&] { toSurfaceMesh(mesh, points); });

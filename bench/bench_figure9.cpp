@@ -47,7 +47,7 @@
 #include "LoopExtraction.h"
 #include "ScanIsoSurface.h"
 #include "BenchSupport.h"
-#include "SphereImage.h"
+#include "Phantoms.h"
 #include "SurfaceMesh.h"
 #include "TrackComponent.h"
 
@@ -74,7 +74,7 @@ struct Options {
   bool plot = true;
   bool generic = true;   // also time the per-voxel (generic operator()) scan, for reference
   bool corrupt = false;  // --corrupt: reverse one triangle of method 2 to prove the check works
-  std::uint64_t noiseSeed = bench::kDefaultNoiseSeed;
+  std::uint64_t noiseSeed = kDefaultNoiseSeed;
   std::string commandLine;
 };
 
@@ -248,7 +248,7 @@ struct Row {
   std::size_t components = 0;      // components (kappa-lambda-boundaries) found by scanning
   std::size_t allSurfels = 0, allTriangles = 0;  // method 1's whole mesh
   std::size_t surfels = 0, triangles = 0;        // the seed's component
-  Surfel seed{};  // bench::protocolSeed
+  Surfel seed{};  // protocolSeed
   int runs = 0;
   Samples scan, extract, scanExtract, track, loops, trackLoops, openmesh, generic;
 };
@@ -268,8 +268,8 @@ Row measure(const Options& o, int q, double noise) {
   std::snprintf(tag, sizeof tag, "q=%d p=%g%%", q, 100 * noise);
 
   std::fprintf(stderr, "[%s] generating the %d^3 sphere image...\n", tag, q);
-  bench::NoisySphere sphere = bench::makeNoisySphere(q, noise, o.noiseSeed);
-  const Surfel seed = bench::protocolSeed(sphere);
+  NoisyPhantom sphere = makeNoisySphere(q, noise, o.noiseSeed);
+  const Surfel seed = protocolSeed(sphere);
   row.seed = seed;
   if (seed.c.y != q / 2 || seed.c.z != q / 2)
     std::fprintf(stderr, "[%s] noise hit the sphere's surfel on the +x ray through (q/2, q/2): the "

@@ -26,7 +26,7 @@
 #include "DigitalCube.h"
 #include "ScanIsoSurface.h"
 #include "BenchSupport.h"
-#include "SphereImage.h"
+#include "Phantoms.h"
 
 using namespace surftrack;
 
@@ -152,9 +152,9 @@ int main(int argc, char** argv) try {
               "MC ms", "MC vox/s", "1b ms");
   for (int q : o.sides)
     for (double noise : o.noises) {
-      const bench::NoisySphere sphere = bench::makeNoisySphere(q, noise);
+      const NoisyPhantom sphere = makeNoisySphere(q, noise);
       const auto image = sphere.binary();
-      const Surfel seed = bench::protocolSeed(sphere);
+      const Surfel seed = protocolSeed(sphere);
       const double voxels = double(q) * q * q;
 
       std::size_t surfels = 0, triangles = 0, components = 0;
@@ -168,7 +168,7 @@ int main(int argc, char** argv) try {
       const double generic = o.generic ? bench::medianSeconds(o.runs, [&] {
         return scanIsoSurfaceGeneric(image, o.pair, 1);
       }, clock) : 0.0;
-      const ClassicMarchingCubes classic(sphere.image, std::uint8_t(bench::kSphereIsoValue));
+      const ClassicMarchingCubes classic(sphere.image, std::uint8_t(kPhantomIsoValue));
       {
         const TriangleMesh check = classic.run(o.pair);
         if (check.triangles.size() != triangles || check.surfels.size() != surfels)

@@ -31,7 +31,7 @@
 #include "BenchSupport.h"
 #include "FindSeed.h"
 #include "HashSetTraversal.h"
-#include "SphereImage.h"
+#include "Phantoms.h"
 #include "TrackComponent.h"
 
 using namespace surftrack;
@@ -160,9 +160,9 @@ int main(int argc, char** argv) {
                 baseline ? "  hash-set M/s cpu  ratio" : "");
     for (int q : sizes)
       for (double noise : {0.0, 0.01, 0.05}) {
-        const bench::NoisySphere sphere = bench::makeNoisySphere(q, noise);
+        const NoisyPhantom sphere = makeNoisySphere(q, noise);
         const auto image = sphere.binary();
-        const Surfel seed = bench::protocolSeed(sphere);
+        const Surfel seed = protocolSeed(sphere);
         const int runs = q >= 512 ? std::min(reps, 3) : reps;
         const Measurement m = measure(runs, [&] { return trackComponent(image, seed, pair).surfelCount(); });
         const Measurement b = baseline ? measure(runs, [&] { return bench::hashSetTraversal(image, seed, pair); })
@@ -171,12 +171,8 @@ int main(int argc, char** argv) {
         if (breakdown) printBreakdown(runs, image, trackComponent(image, seed, pair), m);
       }
     if (implicitBall) {
-      const int c = 2048, radius = 900;
-      const std::int64_t r2 = std::int64_t(radius) * radius;
-      const ImplicitImage ball({4096, 4096, 4096}, [&](int x, int y, int z) {
-        const std::int64_t dx = x - c, dy = y - c, dz = z - c;
-        return dx * dx + dy * dy + dz * dz <= r2;
-      });
+      const int c = 2048;
+      const ImplicitImage ball({4096, 4096, 4096}, Ball::ofRadius({c, c, c}, 900));
       const Surfel seed = *seedAlongRay(ball, Voxel{c, c, c}, 0);
       const int runs = std::min(reps, 3);
       const Measurement m = measure(runs, [&] { return trackComponent(ball, seed, pair).surfelCount(); });

@@ -11,7 +11,7 @@
 #include "Commands.h"
 #include "Extraction.h"
 #include "OutputFile.h"
-#include "Phantom.h"
+#include "Phantoms.h"
 #include "Report.h"
 
 namespace surftrack::cli {
@@ -101,7 +101,7 @@ int runDemo(const std::vector<std::string>& args) {
   // 1. The phantom.
   {
     StageClock clock;
-    const Phantom phantom = makePhantom(o.size, o.noise);
+    const SphereMinusCylinders phantom = makeSphereMinusCylinders(o.size, o.noise);
     const std::string volumePath = (dir / "phantom.nrrd").string();
     io::writeVolume(io::AnyVolume(phantom.image), volumePath);
     const double buildSeconds = clock.total();

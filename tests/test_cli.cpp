@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "Phantoms.h"
 #include "cli/CliTestSupport.h"
 
 namespace surftrack {
@@ -76,16 +77,10 @@ DenseImage<T> boxVolume(Dims dims, Voxel lo, Voxel hi, T in, T out, ImageGeometr
   return image;
 }
 
-/// Adds a ball of value `in`, radius r (voxels with |v - c|^2 <= r^2).
+/// Adds a ball of value `in`, radius r (voxels with |v - c|^2 <= r^2; lib/Phantoms.h).
 template <class T>
 void addBall(DenseImage<T>& image, Voxel c, int r, T in) {
-  const Dims& d = image.dims();
-  for (int z = 0; z < d.nz; ++z)
-    for (int y = 0; y < d.ny; ++y)
-      for (int x = 0; x < d.nx; ++x) {
-        const int dx = x - c.x, dy = y - c.y, dz = z - c.z;
-        if (dx * dx + dy * dy + dz * dz <= r * r) image.at(x, y, z) = in;
-      }
+  paintBall(image, Ball::ofRadius(c, r), in);
 }
 
 template <class T>

@@ -18,6 +18,7 @@
 #include "LoopExtraction.h"
 #include "PairTestName.h"
 #include "MeshIO.h"
+#include "Phantoms.h"
 #include "ScanBoundaries.h"
 #include "SurfaceMesh.h"
 #include "TrackComponent.h"
@@ -369,10 +370,10 @@ TEST(LoopExtractionCost, ReadsVoxelsInProportionToTheSurfaceOnly) {
   // A ball in a 2^18-sided domain: anything O(volume) would never finish.
   std::size_t reads = 0;
   const int c = 1 << 17;
+  const Ball inBall = Ball::ofRadius({c, c, c}, 30);
   const ImplicitImage ball({1 << 18, 1 << 18, 1 << 18}, [&](int x, int y, int z) {
     ++reads;
-    const long dx = x - c, dy = y - c, dz = z - c;
-    return dx * dx + dy * dy + dz * dz <= 30L * 30L;
+    return inBall(x, y, z);
   });
   const SurfaceGraph graph = trackComponent(ball, Surfel{{c + 30, c, c}, 0}, AdjacencyPair::k26_6);
   reads = 0;

@@ -16,9 +16,9 @@
 #include <set>
 #include <vector>
 
-#include "../bench/SphereImage.h"
 #include "DigitalCube.h"
 #include "LoopExtraction.h"
+#include "Phantoms.h"
 #include "ScanBoundaries.h"
 #include "ScanIsoSurface.h"
 #include "TrackComponent.h"
@@ -177,7 +177,7 @@ TEST(ScanIsoSurface, EveryThreadCountGivesTheSameMesh) {
   for (AdjacencyPair pair : kAllAdjacencyPairs) {
     for (const BinaryVolume& v : randomImages(40, 31)) check(binaryView(v), pair, "random");
     for (Dims d : kWordBoundaryDims) check(binaryView(randomVolume(d, 0.5, 5 + d.nx)), pair, "word boundaries");
-    const bench::NoisySphere sphere = bench::makeNoisySphere(48, 0.05, 9);
+    const NoisyPhantom sphere = makeNoisySphere(48, 0.05, 9);
     check(sphere.binary(), pair, "sphere");
   }
 }
@@ -214,7 +214,7 @@ TEST(ScanIsoSurface, FastPathGenericPathAndNaiveReferenceAgree) {
         check(binaryView(v, /*outside=*/true), pair, "outside is 1");
       }
     for (double noise : {0.0, 0.05}) {
-      const bench::NoisySphere sphere = bench::makeNoisySphere(40, noise, 5);
+      const NoisyPhantom sphere = makeNoisySphere(40, noise, 5);
       check(sphere.binary(), pair, "sphere");
     }
   }
@@ -242,9 +242,7 @@ TEST(ScanIsoSurface, FastPathGenericPathAndNaiveReferenceAgree) {
   const BinaryVolume labels = randomVolume({20, 9, 7}, 0.5, 1);
   const LabelImage<std::uint8_t> label(labels, 0);
   EXPECT_EQ(triangleTriples(scanIsoSurface(label, AdjacencyPair::k26_6)), referenceTriples(label, AdjacencyPair::k26_6));
-  const ImplicitImage ball({21, 21, 21}, [](int x, int y, int z) {
-    return (x - 10) * (x - 10) + (y - 10) * (y - 10) + (z - 10) * (z - 10) <= 64;
-  });
+  const ImplicitImage ball({21, 21, 21}, Ball::ofRadius({10, 10, 10}, 8));
   EXPECT_EQ(triangleTriples(scanIsoSurface(ball, AdjacencyPair::k6_18)), referenceTriples(ball, AdjacencyPair::k6_18));
 }
 
@@ -335,9 +333,9 @@ TEST(ScanIsoSurface, ExtractComponentKeepsTheSeedsComponentRenumbered) {
 
 TEST(ScanIsoSurface, NoisySphereOfTheProtocol) {
   for (double noise : {0.0, 0.01, 0.05}) {
-    const bench::NoisySphere sphere = bench::makeNoisySphere(48, noise);
+    const NoisyPhantom sphere = makeNoisySphere(48, noise);
     const auto image = sphere.binary();
-    const Surfel seed = bench::protocolSeed(sphere, 48);
+    const Surfel seed = protocolSeed(sphere);
     // The seed is a boundary surfel on the +x ray, untouched by noise, about R from the centre.
     EXPECT_TRUE(image(seed.inside()) && !image(seed.outside()));
     EXPECT_FALSE(sphere.changed(seed.inside()) || sphere.changed(seed.outside()));
@@ -358,16 +356,16 @@ TEST(ScanIsoSurface, NoisySphereOfTheProtocol) {
     }
   }
   // When noise hit a voxel of the crossing on the +x ray, the seed comes from the next row.
-  bench::NoisySphere damaged = bench::makeNoisySphere(48, 0.0);
-  const Surfel onRay = bench::protocolSeed(damaged);
+  NoisyPhantom damaged = makeNoisySphere(48, 0.0);
+  const Surfel onRay = protocolSeed(damaged);
   damaged.hit.assign(damaged.image.dims().count(), 0);
   damaged.hit[damaged.image.index(onRay.c.x, onRay.c.y, onRay.c.z)] = 1;
-  const Surfel moved = bench::protocolSeed(damaged);
+  const Surfel moved = protocolSeed(damaged);
   EXPECT_EQ(moved.c.y, onRay.c.y + 1);
   EXPECT_EQ(moved.c.z, onRay.c.z);
   EXPECT_FALSE(damaged.changed(moved.inside()) || damaged.changed(moved.outside()));
   // Noise changes about the requested fraction of voxels, half of them to 255.
-  const bench::NoisySphere noisy = bench::makeNoisySphere(64, 0.05);
+  const NoisyPhantom noisy = makeNoisySphere(64, 0.05);
   std::size_t hits = 0, white = 0;
   for (std::size_t i = 0; i < noisy.hit.size(); ++i)
     if (noisy.hit[i]) {

@@ -8,6 +8,7 @@
 #include <boost/range/iterator_range.hpp>
 
 #include "FindSeed.h"
+#include "Phantoms.h"
 #include "TrackComponent.h"
 #include "VoxelComponents.h"
 
@@ -29,10 +30,7 @@ TEST(Tracking, ImplicitBallOfRadius900InA4096CubedDomain) {
   // 68 G voxels: this image can be neither stored nor scanned; tracking touches its surface only.
   const int c = 2048, radius = 900;
   const std::int64_t r2 = std::int64_t(radius) * radius;
-  const ImplicitImage ball({4096, 4096, 4096}, [&](int x, int y, int z) {
-    const std::int64_t dx = x - c, dy = y - c, dz = z - c;
-    return dx * dx + dy * dy + dz * dz <= r2;
-  });
+  const ImplicitImage ball({4096, 4096, 4096}, Ball{{c, c, c}, r2});
   const auto seed = seedAlongRay(ball, Voxel{c, c, c}, 0);
   ASSERT_TRUE(seed.has_value());
   EXPECT_EQ(*seed, (Surfel{{c + radius, c, c}, 0}));
@@ -50,9 +48,7 @@ TEST(Tracking, ImplicitBallOfRadius900InA4096CubedDomain) {
 }
 
 TEST(Tracking, BallFromAnySeedInEveryPair) {
-  const ImplicitImage ball({40, 40, 40}, [](int x, int y, int z) {
-    return (x - 20) * (x - 20) + (y - 19) * (y - 19) + (z - 21) * (z - 21) <= 150;
-  });
+  const ImplicitImage ball({40, 40, 40}, Ball{{20, 19, 21}, 150});
   for (AdjacencyPair pair : kAllAdjacencyPairs) {
     const SurfaceGraph g = trackComponent(ball, *seedAlongRay(ball, Voxel{20, 19, 21}, 3), pair);
     EXPECT_EQ(std::int64_t(g.surfelCount()), 2 * 3 * linesMeetingBall(150, 13));
