@@ -2,7 +2,7 @@
 """The Python package against scikit-image and VTK, and against its own C++ core, in one run.
 
 Inputs (all made or loaded once, before any timing):
-  - the Figure 9 spheres of bench/SphereImage.h at q = 256 and 512 with 0, 1 and 5 % noise,
+  - the Figure 9 spheres of lib/Phantoms.h at q = 256 and 512 with 0, 1 and 5 % noise,
     regenerated here in numpy byte for byte: the same gray-value formula (same floating-point
     operations, std::round's half-away-from-zero) and the same noise, drawn from a numpy
     re-implementation of std::mt19937_64 (checked against the C++ standard's 10000th value);
@@ -42,8 +42,8 @@ import time
 
 import numpy as np
 
-SPHERE_ISO = 127.5          # bench/SphereImage.h kSphereIsoValue
-NOISE_SEED = 20240601       # bench/SphereImage.h kDefaultNoiseSeed
+SPHERE_ISO = 127.5          # lib/Phantoms.h kSphereIsoValue
+NOISE_SEED = 20240601       # lib/Phantoms.h kDefaultNoiseSeed
 MRI_ISO = 100.0             # cli/DemoCommand.cpp kCortexIso
 MRI_PATH = "/usr/share/mricron/templates/ch2better.nii.gz"
 
@@ -122,7 +122,7 @@ def _check_mt19937_64():
 
 
 # --------------------------------------------------------------------------------------------
-# The Figure 9 sphere (bench/SphereImage.h) and its protocol seed
+# The Figure 9 sphere (lib/Phantoms.h) and its protocol seed
 # --------------------------------------------------------------------------------------------
 def _std_round(v: np.ndarray) -> np.ndarray:
     """std::round: halves away from zero (numpy's round goes to even). Exact in floating point."""
