@@ -1,9 +1,10 @@
 // Conversion throughput: from a tracked surface graph to the indexed triangle list
 // (extractLoops, paper §5.2) — from the image bricks the graph keeps, and for comparison from
-// the image itself, which binarises it again — then, separately, the iso-value mapping of the vertices and the
-// construction of the OpenMesh half-edge mesh, on the noisy spheres of the Figure 9 protocol
-// (docs/figure9.md, 'Protocol').
-// Medians of several runs, one thread.
+// the image itself, which binarises it again — then, separately, the iso-value mapping of the
+// vertices and the construction of the OpenMesh half-edge mesh, both ways: toSurfaceMesh (built
+// directly from the oriented triangles) and toSurfaceMeshByAddFace (the add_face reference), on
+// the noisy spheres of the Figure 9 protocol (docs/figure9.md, 'Protocol').
+// Medians of several runs, one thread; each result is destroyed outside the timing.
 //
 //   bench_conversion [--sizes 64,128,...] [--reps N] [--pair 26-6]
 #include <algorithm>
@@ -23,6 +24,24 @@
 
 using namespace surftrack;
 
+namespace {
+
+const char* const kUsage =
+    "usage: bench_conversion [--sizes 64,128,...] [--reps N] [--pair 26-6]\n"
+    "\n"
+    "Conversion throughput on the noisy spheres of the Figure 9 protocol (noise 0, 1, 5 %),\n"
+    "one thread, median of N runs: tracking, extractLoops from the graph's bricks and from\n"
+    "the image, the iso-value mapping of the vertices, and the OpenMesh half-edge mesh built\n"
+    "with add_face (toSurfaceMeshByAddFace) and directly (toSurfaceMesh; also on the thread's\n"
+    "CPU clock). Results are destroyed outside the timing.\n"
+    "\n"
+    "  --sizes LIST  sphere image sides (default 128,256,512)\n"
+    "  --reps N      runs per measurement (default 5)\n"
+    "  --pair P      adjacency pair: 26-6, 18-6, 6-18 or 6-26 (default 26-6)\n"
+    "  --help        this text\n";
+
+}  // namespace
+
 int main(int argc, char** argv) {
   try {
     std::vector<int> sizes{128, 256, 512};
@@ -34,20 +53,24 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
         return argv[++i];
       };
-      if (a == "--sizes") {
+      if (a == "--help" || a == "-h") {
+        std::cout << kUsage;
+        return 0;
+      } else if (a == "--sizes") {
         sizes = bench::parseList<int>(value(), "size");
       } else if (a == "--reps") {
         reps = std::stoi(value());
       } else if (a == "--pair") {
         pair = parseAdjacencyPair(value());
       } else {
-        throw std::invalid_argument("unknown option " + a);
+        throw std::invalid_argument("unknown option " + a + " (see --help)");
       }
     }
     std::printf("conversion, pair %s, median of %d runs, one thread (ms; M triangles/s)\n",
                 toString(pair).c_str(), reps);
-    std::printf("%-18s %10s %10s %10s %8s %12s %8s %10s %10s %8s\n", "case", "triangles", "track",
-                "loops", "M tri/s", "loops(image)", "M tri/s", "mapping", "openmesh", "M tri/s");
+    std::printf("%-18s %10s %10s %10s %8s %12s %8s %10s %10s %8s %10s %8s %10s %8s %7s\n", "case",
+                "triangles", "track", "loops", "M tri/s", "loops(image)", "M tri/s", "mapping",
+                "add_face", "M tri/s", "direct", "M tri/s", "direct cpu", "M tri/s", "speedup");
     for (int q : sizes)
       for (double noise : {0.0, 0.01, 0.05}) {
         const NoisyPhantom sphere = makeNoisySphere(q, noise);
@@ -65,12 +88,25 @@ int main(int argc, char** argv) {
         const IsoValueMapping<std::uint8_t> mapping(sphere.image, kPhantomIsoValue);
         std::vector<std::array<double, 3>> points;
         const double map = bench::medianSeconds(reps, [&] { points = mapVertices(mesh, mapping, {}); });
-        const double build = bench::medianSeconds(reps, [&] { toSurfaceMesh(mesh, points); });
+        // The OpenMesh half-edge mesh, by add_face (the reference) and built directly.
+        const double byAddFace =
+            bench::medianSeconds(reps, [&] { return toSurfaceMeshByAddFace(mesh, points); });
+        const double direct = bench::medianSeconds(reps, [&] { return toSurfaceMesh(mesh, points); });
+        // The same on this thread's CPU clock, which a loaded machine inflates less.
+        const double directCpu = bench::medianSeconds(
+            reps, [&] { return toSurfaceMesh(mesh, points); }, bench::threadCpuSeconds);
+        {
+          const SurfaceMesh a = toSurfaceMesh(mesh, points), b = toSurfaceMeshByAddFace(mesh, points);
+          if (a.n_vertices() != b.n_vertices() || a.n_edges() != b.n_edges() || a.n_faces() != b.n_faces())
+            throw std::logic_error("the two OpenMesh constructions disagree");
+        }
         const double tri = double(mesh.triangles.size());
-        std::printf("q=%-4d p=%-2d%%       %10zu %10.1f %10.1f %8.2f %12.1f %8.2f %10.1f %10.1f %8.2f\n",
+        std::printf("q=%-4d p=%-2d%%       %10zu %10.1f %10.1f %8.2f %12.1f %8.2f %10.1f %10.1f %8.2f "
+                    "%10.1f %8.2f %10.1f %8.2f %6.1fx\n",
                     q, int(noise * 100), mesh.triangles.size(), 1e3 * track, 1e3 * loops,
-                    tri / loops / 1e6, 1e3 * checked, tri / checked / 1e6, 1e3 * map, 1e3 * build,
-                    tri / build / 1e6);
+                    tri / loops / 1e6, 1e3 * checked, tri / checked / 1e6, 1e3 * map, 1e3 * byAddFace,
+                    tri / byAddFace / 1e6, 1e3 * direct, tri / direct / 1e6, 1e3 * directCpu,
+                    tri / directCpu / 1e6, byAddFace / direct);
         std::fflush(stdout);
       }
     return 0;

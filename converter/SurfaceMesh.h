@@ -48,12 +48,30 @@ std::vector<std::array<double, 3>> mapVertices(const TriangleMesh& mesh, const M
   return positions;
 }
 
-/// The OpenMesh mesh of an indexed mesh: vertex v at positions[v] with surfel mesh.surfels[v].
-/// Throws std::invalid_argument if the sizes differ, std::logic_error if OpenMesh refuses a
-/// face (a complex edge or vertex: the triangles are not a manifold, which a correct
-/// conversion never produces).
+/// The OpenMesh mesh of an indexed mesh: vertex v at positions[v] with surfel mesh.surfels[v],
+/// face f the triangle mesh.triangles[f]. The half-edge structure is built directly from the
+/// oriented triangles with OpenMesh's kernel (no add_face), in O(V + F): a counting sort of
+/// the triangle corners by vertex, then each vertex's fan is checked and its edges paired from
+/// its own corners. Edges and halfedges get the indices toSurfaceMeshByAddFace gives them
+/// (edge e is the e-th edge met in face order, its halfedge 2e runs as in that first face),
+/// and so do faces' halfedges; a vertex's halfedge is one of its outgoing halfedges (the mesh
+/// is closed, none is a boundary halfedge). Large arrays are advised for huge pages
+/// (lib/HugePages.h).
+/// Throws std::invalid_argument if the sizes differ or a vertex index is out of range, and
+/// std::logic_error if the triangles are not a closed, consistently oriented 2-manifold (which
+/// a correct conversion never produces, paper §5.2 and docs/theory.md): a degenerate triangle,
+/// an edge in one triangle or in more than two, an edge used twice in the same direction, a
+/// vertex whose triangles do not form a single fan, or a vertex in no triangle.
 SurfaceMesh toSurfaceMesh(const TriangleMesh& mesh,
                           const std::vector<std::array<double, 3>>& positions);
+
+/// The reference construction: the same mesh built face by face with OpenMesh's add_face, whose
+/// own topology checks refuse a complex edge or vertex. Several times slower than toSurfaceMesh
+/// (docs/performance.md); kept as an independent check of it. Throws std::invalid_argument like
+/// toSurfaceMesh, std::logic_error if OpenMesh refuses a face; unlike toSurfaceMesh it accepts
+/// vertices in no triangle and open surfaces.
+SurfaceMesh toSurfaceMeshByAddFace(const TriangleMesh& mesh,
+                                   const std::vector<std::array<double, 3>>& positions);
 
 /// Track-to-mesh in one call: the continuous analog of the boundary of `graph` (extractLoops),
 /// vertices placed by `mapping` and `geometry`.
