@@ -1,4 +1,6 @@
 // The ITK half of io/: the only translation unit of the project that includes ITK headers.
+// readVolume copies what ITK decodes into a DenseImage; the loader (io/LoadVolume.cpp) reads
+// headers through it (readItkHeader) and views ITK's decoded buffer in place (decodeWithItk).
 #include "ReadVolume.h"
 
 #include <algorithm>
@@ -9,6 +11,8 @@
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include <gdcmTrace.h>
 #include <gdcmUIDGenerator.h>
@@ -28,6 +32,8 @@
 #include <itkTIFFImageIOFactory.h>
 #include <itkVTKImageIOFactory.h>
 #include <zlib.h>
+
+#include "Internal.h"
 
 namespace surftrack::io {
 
@@ -92,9 +98,13 @@ std::optional<ScalarType> scalarTypeOf(itk::IOComponentEnum c) {
   }
 }
 
-/// Copies an ITK image into a DenseImage with its geometry.
 template <class T>
-AnyVolume toDense(const itk::Image<T, 3>* image, const std::string& path) {
+using ImagePointer = typename itk::Image<T, 3>::Pointer;
+
+/// The domain and geometry of an ITK image (or of a reader's output after
+/// UpdateOutputInformation, before any voxel is read), with readVolume's checks.
+template <class T>
+std::pair<Dims, ImageGeometry> domainOf(const itk::Image<T, 3>* image, const std::string& path) {
   const auto region = image->GetLargestPossibleRegion();
   const auto size = region.GetSize();
   Dims dims{int(size[0]), int(size[1]), int(size[2])};
@@ -107,31 +117,53 @@ AnyVolume toDense(const itk::Image<T, 3>* image, const std::string& path) {
     if (!(geometry.spacing[a] > 0) || !std::isfinite(geometry.spacing[a]))
       throw ReadError("cannot read '" + path + "': its voxel spacing is not positive");
   }
+  return {dims, geometry};
+}
+
+/// Copies an ITK image into a DenseImage with its geometry.
+template <class T>
+AnyVolume toDense(const itk::Image<T, 3>* image, const std::string& path) {
+  const auto [dims, geometry] = domainOf(image, path);
   DenseImage<T> out(dims, T{}, geometry);
   const T* buffer = image->GetBufferPointer();
   std::copy(buffer, buffer + dims.count(), out.data().begin());
   return AnyVolume(std::move(out));
 }
 
+/// Views an ITK image's own buffer (x fastest, contiguous), which `owner` keeps alive.
 template <class T>
-AnyVolume readFileAs(itk::ImageIOBase* imageIO, const std::string& path) {
+LoadedVolume toLoaded(const itk::SmartPointer<itk::Image<T, 3>>& image, const std::string& path) {
+  const auto [dims, geometry] = domainOf(image.GetPointer(), path);
+  LoadedVolume out;
+  out.view = VolumeView::of<T>(image->GetBufferPointer(), dims, geometry);
+  out.owner = std::shared_ptr<const void>(image->GetBufferPointer(), [image](const void*) {});
+  out.dataBytes = dims.count() * sizeof(T);
+  return out;
+}
+
+template <class T>
+ImagePointer<T> readFileAs(itk::ImageIOBase* imageIO, const std::string& path) {
   using Image = itk::Image<T, 3>;
   auto reader = itk::ImageFileReader<Image>::New();
   reader->SetFileName(path);
   reader->SetImageIO(imageIO);
   reader->Update();
-  return toDense<T>(reader->GetOutput(), path);
+  ImagePointer<T> image = reader->GetOutput();
+  image->DisconnectPipeline();
+  return image;
 }
 
 template <class T>
-AnyVolume readSeriesAs(const std::vector<std::string>& files, const std::string& path) {
+ImagePointer<T> readSeriesAs(const std::vector<std::string>& files) {
   using Image = itk::Image<T, 3>;
   auto reader = itk::ImageSeriesReader<Image>::New();
   auto dicom = itk::GDCMImageIO::New();
   reader->SetImageIO(dicom);
   reader->SetFileNames(files);
   reader->Update();
-  return toDense<T>(reader->GetOutput(), path);
+  ImagePointer<T> image = reader->GetOutput();
+  image->DisconnectPipeline();
+  return image;
 }
 
 std::string unsupportedType(const std::string& path, const std::string& what) {
@@ -139,7 +171,9 @@ std::string unsupportedType(const std::string& path, const std::string& what) {
          "': supported are uint8, int16, uint16, int32, float and double";
 }
 
-AnyVolume readDicomDirectory(const std::string& path) {
+/// Reads the first DICOM series of a directory and hands the image to `use`.
+template <class Use>
+auto readDicomDirectory(const std::string& path, Use&& use) {
   auto names = itk::GDCMSeriesFileNames::New();
   names->SetUseSeriesDetails(true);
   names->SetDirectory(path);
@@ -155,7 +189,7 @@ AnyVolume readDicomDirectory(const std::string& path) {
                                               " components per voxel"));
   const auto type = scalarTypeOf(dicom->GetComponentType());
   if (!type) throw ReadError(unsupportedType(path, "'" + componentName(dicom->GetComponentType()) + "'"));
-  return visitScalarType(*type, [&](auto v) { return readSeriesAs<decltype(v)>(files, path); });
+  return visitScalarType(*type, [&](auto v) { return use(readSeriesAs<decltype(v)>(files), std::string("dicom")); });
 }
 
 std::string lowerName(const std::string& path) {
@@ -201,45 +235,62 @@ std::int64_t contentSize(const std::string& path) {
 }
 
 /// NIfTI (.nii, .nii.gz, .hdr/.img): ITK's reader fills a short data block with zeros without
-/// a word, so compare the data size with the header's vox_offset + voxel bytes.
-void requireCompleteNifti(const std::string& path, std::size_t dataBytes) {
+/// a word, so compare the data size with the header's vox_offset + voxel bytes. The bytes per
+/// voxel are those of the header's datatype (as niftilib reads it), not ITK's component size:
+/// ITK reports scaled integer voxels (scl_slope) as float.
+void requireCompleteNifti(const std::string& path, std::size_t voxels, std::size_t componentSize) {
   const std::string name = lowerName(path);
   std::string dataFile = path;
   double offset = 0;
   const bool single = endsWith(name, ".nii") || endsWith(name, ".nii.gz");
-  if (single) {
-    gzFile f = gzopen(path.c_str(), "rb");
-    unsigned char header[544] = {};
-    const int n = f ? gzread(f, header, sizeof header) : -1;
-    if (f) gzclose(f);
-    if (n < 348) throw ReadError("cannot read '" + path + "': the file is truncated (no complete NIfTI header)");
-    std::int32_t sizeofHdr;
-    std::memcpy(&sizeofHdr, header, 4);
-    const bool swapped = sizeofHdr != 348 && sizeofHdr != 540;
-    auto get = [&](std::size_t at, std::size_t bytes, void* out) {
-      unsigned char tmp[8];
-      std::memcpy(tmp, header + at, bytes);
-      if (swapped) std::reverse(tmp, tmp + bytes);
-      std::memcpy(out, tmp, bytes);
-    };
-    get(0, 4, &sizeofHdr);
-    if (sizeofHdr == 348) {
-      float voxOffset;
-      get(108, 4, &voxOffset);
-      offset = voxOffset;
-    } else if (sizeofHdr == 540) {
-      std::int64_t voxOffset;
-      get(168, 8, &voxOffset);
-      offset = double(voxOffset);
-    } else {
-      return;  // not a header we know: leave it to ITK
-    }
-  } else if (endsWith(name, ".hdr") || endsWith(name, ".hdr.gz")) {
+  const bool pair = endsWith(name, ".hdr") || endsWith(name, ".hdr.gz");
+  if (!single && !pair) return;
+  gzFile f = gzopen(path.c_str(), "rb");
+  unsigned char header[544] = {};
+  const int n = f ? gzread(f, header, sizeof header) : -1;
+  if (f) gzclose(f);
+  if (n < 348) throw ReadError("cannot read '" + path + "': the file is truncated (no complete NIfTI header)");
+  std::int32_t sizeofHdr;
+  std::memcpy(&sizeofHdr, header, 4);
+  const bool swapped = sizeofHdr != 348 && sizeofHdr != 540;
+  auto get = [&](std::size_t at, std::size_t bytes, void* out) {
+    unsigned char tmp[8];
+    std::memcpy(tmp, header + at, bytes);
+    if (swapped) std::reverse(tmp, tmp + bytes);
+    std::memcpy(out, tmp, bytes);
+  };
+  get(0, 4, &sizeofHdr);
+  std::int16_t datatype = 0;
+  if (sizeofHdr == 348) {  // NIfTI-1 (or Analyze 7.5): datatype at 70, vox_offset at 108
+    get(70, 2, &datatype);
+    float voxOffset;
+    get(108, 4, &voxOffset);
+    if (single) offset = voxOffset;
+  } else if (sizeofHdr == 540 && n >= 540) {  // NIfTI-2: datatype at 12, vox_offset at 168
+    get(12, 2, &datatype);
+    std::int64_t voxOffset;
+    get(168, 8, &voxOffset);
+    if (single) offset = double(voxOffset);
+  } else {
+    return;  // not a header we know: leave it to ITK
+  }
+  if (!(offset >= 0)) offset = 0;  // (a negative or NaN vox_offset must not hide a short file)
+  std::size_t bytesPerVoxel = componentSize;
+  switch (datatype) {  // nifti1.h's DT_* codes and their sizes
+    case 2: case 256: bytesPerVoxel = 1; break;
+    case 4: case 512: bytesPerVoxel = 2; break;
+    case 128: bytesPerVoxel = 3; break;
+    case 8: case 16: case 768: case 2304: bytesPerVoxel = 4; break;
+    case 32: case 64: case 1024: case 1280: bytesPerVoxel = 8; break;
+    case 1536: case 1792: bytesPerVoxel = 16; break;
+    case 2048: bytesPerVoxel = 32; break;
+    default: break;
+  }
+  const std::size_t dataBytes = voxels * bytesPerVoxel;
+  if (pair) {
     dataFile = path.substr(0, path.size() - (endsWith(name, ".gz") ? 7 : 4)) + ".img";
     std::error_code ec;
     if (!fs::exists(dataFile, ec) && fs::exists(dataFile + ".gz", ec)) dataFile += ".gz";
-  } else {
-    return;
   }
   const std::int64_t size = contentSize(dataFile);
   if (size < 0) throw ReadError("cannot read '" + path + "': corrupt compressed data");
@@ -252,7 +303,7 @@ void requireCompleteNifti(const std::string& path, std::size_t dataBytes) {
 /// A data file (.raw of a .mhd, data of a .nhdr) that is shorter than its header says is
 /// read by some ITK readers without complaint; check the size where it is cheap to know.
 void requireCompleteData(itk::ImageIOBase* imageIO, const std::string& path, std::size_t voxels) {
-  requireCompleteNifti(path, voxels * imageIO->GetComponentSize());
+  requireCompleteNifti(path, voxels, imageIO->GetComponentSize());
   const std::string ext = fs::path(path).extension().string();
   if (ext == ".mha" || ext == ".mhd") {
     // MetaImage: read the header lines up to ElementDataFile.
@@ -261,13 +312,22 @@ void requireCompleteData(itk::ImageIOBase* imageIO, const std::string& path, std
     bool compressed = false;
     std::streamoff headerEnd = 0;
     while (std::getline(in, line)) {
-      if (line.rfind("CompressedData", 0) == 0 && line.find("True") != std::string::npos)
+      // As MetaIO reads a line: the whole key (trimmed) before the first '=' or ':', the value
+      // after it and any further '=', ':' and blanks; a boolean is true when it begins with T,
+      // t or 1.
+      const auto sep = line.find_first_of("=:");
+      if (sep == std::string::npos) continue;
+      std::string key = line.substr(0, sep);
+      key.erase(0, std::min(key.size(), key.find_first_not_of(" \t\r")));
+      key.erase(std::min(key.size(), key.find_last_not_of(" \t\r") + 1));
+      const auto valueAt = line.find_first_not_of("=: \t", sep);
+      const std::string value = valueAt == std::string::npos ? "" : line.substr(valueAt);
+      if (key == "CompressedData" && !value.empty() && (value[0] == 'T' || value[0] == 't' || value[0] == '1'))
         compressed = true;
-      if (line.rfind("ElementDataFile", 0) == 0) {
-        auto eq = line.find('=');
-        dataFile = line.substr(eq == std::string::npos ? line.size() : eq + 1);
-        dataFile.erase(0, dataFile.find_first_not_of(" \t"));
-        while (!dataFile.empty() && (dataFile.back() == '\r' || dataFile.back() == ' '))
+      if (key == "ElementDataFile") {
+        dataFile = value;  // without what MetaIO strips from its end: white space, unprintable bytes
+        while (!dataFile.empty() && (static_cast<unsigned char>(dataFile.back()) <= 0x20 ||
+                                     static_cast<unsigned char>(dataFile.back()) >= 0x7f))
           dataFile.pop_back();
         headerEnd = in.tellg();
         break;
@@ -276,10 +336,10 @@ void requireCompleteData(itk::ImageIOBase* imageIO, const std::string& path, std
     if (compressed || dataFile.empty()) return;
     const std::size_t bytes = voxels * imageIO->GetComponentSize();
     std::error_code ec;
-    if (dataFile == "LOCAL") {
+    if (dataFile == "LOCAL" || dataFile == "Local" || dataFile == "local") {
       if (fs::file_size(path, ec) < std::uintmax_t(headerEnd) + bytes)
         throw ReadError("cannot read '" + path + "': the file is truncated");
-    } else if (dataFile.find('%') == std::string::npos && dataFile != "LIST") {
+    } else if (dataFile.find('%') == std::string::npos && dataFile.rfind("LIST", 0) != 0) {
       const fs::path data = fs::path(path).parent_path() / dataFile;
       if (!fs::exists(data, ec))
         throw ReadError("cannot read '" + path + "': its data file '" + data.string() + "' is missing");
@@ -289,49 +349,126 @@ void requireCompleteData(itk::ImageIOBase* imageIO, const std::string& path, std
   }
 }
 
-}  // namespace
+/// The ImageIO that reads the file `path`, after readVolume's checks (an existing, readable,
+/// non-empty file ITK recognises, a 3D image of one scalar component per voxel), its header read;
+/// `type` and `voxels` are the voxel type and count.
+itk::ImageIOBase::Pointer openImageIO(const std::string& path, ScalarType& type, std::size_t& voxels) {
+  std::error_code ec;
+  {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) throw ReadError("cannot open '" + path + "': " + std::strerror(errno));
+    if (fs::file_size(path, ec) == 0) throw ReadError("cannot read '" + path + "': the file is empty");
+  }
+  itk::ImageIOBase::Pointer imageIO =
+      itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::IOFileModeEnum::ReadMode);
+  if (!imageIO)
+    throw ReadError("cannot read '" + path +
+                    "': not a recognised image file (NIfTI, NRRD, MetaImage, DICOM, TIFF, VTK); "
+                    "for a raw file give --raw-dims and --raw-type");
+  imageIO->SetFileName(path);
+  imageIO->ReadImageInformation();
+  const unsigned dimension = imageIO->GetNumberOfDimensions();
+  voxels = 1;
+  for (unsigned d = 0; d < dimension; ++d) {
+    voxels *= imageIO->GetDimensions(d);
+    if (d >= 3 && imageIO->GetDimensions(d) != 1)
+      throw ReadError("cannot read '" + path + "': a " + std::to_string(dimension) +
+                      "D image with more than one volume; give a 3D image");
+  }
+  if (imageIO->GetNumberOfComponents() != 1)
+    throw ReadError(unsupportedType(
+        path, "with " + std::to_string(imageIO->GetNumberOfComponents()) + " components per voxel"));
+  const auto t = scalarTypeOf(imageIO->GetComponentType());
+  if (!t) throw ReadError(unsupportedType(path, "'" + componentName(imageIO->GetComponentType()) + "'"));
+  type = *t;
+  return imageIO;
+}
 
-AnyVolume readVolume(const std::string& path) {
+/// The format of a file ITK reads, for LoadedVolume::format: its extension ("nii.gz" for a
+/// gzip'd NIfTI-1), "dicom", "tiff" or "vtk" from the ImageIO.
+std::string formatOf(const itk::ImageIOBase* imageIO, const std::string& path) {
+  const std::string io = imageIO->GetNameOfClass();
+  if (io == "GDCMImageIO") return "dicom";
+  if (io == "TIFFImageIO") return "tiff";
+  if (io == "VTKImageIO") return "vtk";
+  const std::string name = lowerName(path);
+  if (endsWith(name, ".nii.gz")) return "nii.gz";
+  const std::string ext = fs::path(name).extension().string();
+  return ext.size() > 1 ? ext.substr(1) : io;
+}
+
+/// Reads `path` with ITK (a file, or a directory holding a DICOM series) and hands the decoded
+/// image and its format to `use`; readVolume's checks, ITK's errors as ReadError.
+template <class Use>
+auto readWithItk(const std::string& path, Use&& use) {
   registerFactories();
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
   try {
-    if (fs::is_directory(path, ec)) return readDicomDirectory(path);
-    {
-      std::ifstream probe(path, std::ios::binary);
-      if (!probe) throw ReadError("cannot open '" + path + "': " + std::strerror(errno));
-      if (fs::file_size(path, ec) == 0) throw ReadError("cannot read '" + path + "': the file is empty");
-    }
-    itk::ImageIOBase::Pointer imageIO =
-        itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::IOFileModeEnum::ReadMode);
-    if (!imageIO)
-      throw ReadError("cannot read '" + path +
-                      "': not a recognised image file (NIfTI, NRRD, MetaImage, DICOM, TIFF, VTK); "
-                      "for a raw file give --raw-dims and --raw-type");
-    imageIO->SetFileName(path);
-    imageIO->ReadImageInformation();
-    const unsigned dimension = imageIO->GetNumberOfDimensions();
-    std::size_t voxels = 1;
-    for (unsigned d = 0; d < dimension; ++d) {
-      voxels *= imageIO->GetDimensions(d);
-      if (d >= 3 && imageIO->GetDimensions(d) != 1)
-        throw ReadError("cannot read '" + path + "': a " + std::to_string(dimension) +
-                        "D image with more than one volume; give a 3D image");
-    }
-    if (imageIO->GetNumberOfComponents() != 1)
-      throw ReadError(unsupportedType(
-          path, "with " + std::to_string(imageIO->GetNumberOfComponents()) + " components per voxel"));
-    const auto type = scalarTypeOf(imageIO->GetComponentType());
-    if (!type)
-      throw ReadError(unsupportedType(path, "'" + componentName(imageIO->GetComponentType()) + "'"));
+    if (fs::is_directory(path, ec)) return readDicomDirectory(path, use);
+    ScalarType type{};
+    std::size_t voxels = 0;
+    itk::ImageIOBase::Pointer imageIO = openImageIO(path, type, voxels);
     requireCompleteData(imageIO, path, voxels);
-    return visitScalarType(*type, [&](auto v) { return readFileAs<decltype(v)>(imageIO, path); });
+    const std::string format = formatOf(imageIO, path);
+    return visitScalarType(type, [&](auto v) { return use(readFileAs<decltype(v)>(imageIO, path), format); });
   } catch (const itk::ExceptionObject& e) {
     throw ReadError("cannot read '" + path + "': " + oneLine(e));
   } catch (const std::bad_alloc&) {
     throw ReadError("cannot read '" + path + "': out of memory");
   }
 }
+
+}  // namespace
+
+AnyVolume readVolume(const std::string& path) {
+  return readWithItk(path, [&](auto image, const std::string&) -> AnyVolume {
+    return toDense(image.GetPointer(), path);
+  });
+}
+
+namespace detail {
+
+LoadedVolume decodeWithItk(const std::string& path) {
+  return readWithItk(path, [&](auto image, const std::string& format) -> LoadedVolume {
+    LoadedVolume out = toLoaded(image, path);
+    out.format = format;
+    return out;
+  });
+}
+
+ItkHeader readItkHeader(const std::string& path) {
+  registerFactories();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
+  try {
+    ItkHeader header;
+    std::size_t voxels = 0;
+    itk::ImageIOBase::Pointer imageIO = openImageIO(path, header.type, voxels);
+    // The reader's output information is the geometry readVolume gives: ImageFileReader pads
+    // 2D images to 3D, takes the direction cosines as the matrix's columns, etc.
+    visitScalarType(header.type, [&](auto v) {
+      using Image = itk::Image<decltype(v), 3>;
+      auto reader = itk::ImageFileReader<Image>::New();
+      reader->SetFileName(path);
+      reader->SetImageIO(imageIO);
+      reader->UpdateOutputInformation();
+      std::tie(header.dims, header.geometry) = domainOf(reader->GetOutput(), path);
+    });
+    switch (imageIO->GetByteOrder()) {
+      case itk::IOByteOrderEnum::BigEndian: header.byteOrder = ItkHeader::ByteOrder::Big; break;
+      case itk::IOByteOrderEnum::LittleEndian: header.byteOrder = ItkHeader::ByteOrder::Little; break;
+      default: header.byteOrder = ItkHeader::ByteOrder::Unknown; break;
+    }
+    return header;
+  } catch (const itk::ExceptionObject& e) {
+    throw ReadError("cannot read '" + path + "': " + oneLine(e));
+  } catch (const std::bad_alloc&) {
+    throw ReadError("cannot read '" + path + "': out of memory");
+  }
+}
+
+}  // namespace detail
 
 namespace {
 
@@ -366,21 +503,24 @@ typename itk::Image<T, 3>::Pointer toItkImage(const DenseImage<T>& volume) {
 }
 
 template <class T>
-void writeAs(const DenseImage<T>& volume, const std::string& path) {
+void writeAs(const DenseImage<T>& volume, const std::string& path, bool compress) {
   using Image = itk::Image<T, 3>;
   const auto image = toItkImage(volume);
   auto writer = itk::ImageFileWriter<Image>::New();
   writer->SetFileName(path);
   writer->SetInput(image);
+  writer->SetUseCompression(compress);
   writer->Update();
 }
 
 }  // namespace
 
-void writeVolume(const AnyVolume& volume, const std::string& path) {
+void writeVolume(const AnyVolume& volume, const std::string& path) { writeVolume(volume, path, false); }
+
+void writeVolume(const AnyVolume& volume, const std::string& path, bool compress) {
   registerFactories();
   try {
-    std::visit([&](const auto& image) { writeAs(image, path); }, volume);
+    std::visit([&](const auto& image) { writeAs(image, path, compress); }, volume);
   } catch (const itk::ExceptionObject& e) {
     throw std::runtime_error("cannot write '" + path + "': " + oneLine(e));
   }

@@ -62,6 +62,9 @@ AnyVolume readRawVolume(const std::string& path, const RawLayout& layout);
 /// Writes a volume with ITK, in the format of the file name's extension (used by the tests and
 /// by the demo to leave its phantom next to the mesh). Throws std::runtime_error.
 void writeVolume(const AnyVolume& volume, const std::string& path);
+/// The same, compressed if `compress` and the format can be (NRRD: gzip encoding, MetaImage:
+/// CompressedData; a .nii.gz is gzip'd whatever `compress` says).
+void writeVolume(const AnyVolume& volume, const std::string& path, bool compress);
 
 /// Writes a uint8 or uint16 volume as a DICOM series, one file per slice z in `directory`
 /// (which must exist), with each slice's position, the orientation and the spacing (tests).

@@ -1,4 +1,5 @@
-// The ITK-free half of io/: the volume variant, raw files.
+// The ITK-free half of io/: the volume variant, raw files (read into a DenseImage; the checks
+// shared with loadRawVolume).
 #include <array>
 #include <bit>
 #include <cmath>
@@ -7,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "Internal.h"
 #include "ReadVolume.h"
 
 namespace surftrack::io {
@@ -48,19 +50,18 @@ AnyVolume readRawAs(std::ifstream& in, const std::string& path, const RawLayout&
 
 }  // namespace
 
-AnyVolume readRawVolume(const std::string& path, const RawLayout& layout) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
-  if (!fs::is_regular_file(path, ec)) throw ReadError("cannot read '" + path + "': not a regular file");
+namespace detail {
+
+void requireRawLayout(const std::string& path, const RawLayout& layout, std::uintmax_t size) {
   if (layout.dims.empty())
     throw ReadError("cannot read raw file '" + path + "': dimensions must be positive");
   for (int a = 0; a < 3; ++a)
     if (!(layout.geometry.spacing[a] > 0) || !std::isfinite(layout.geometry.spacing[a]))
       throw ReadError("cannot read raw file '" + path + "': spacing must be positive");
-  const std::uintmax_t size = fs::file_size(path, ec);
+  if (layout.dims.count() > (std::uintmax_t(1) << 62) / sizeOf(layout.type) ||
+      layout.headerBytes > (std::uintmax_t(1) << 62))
+    throw ReadError("cannot read raw file '" + path + "': more than 2^62 bytes of header or voxels");
   const std::uintmax_t expected = layout.headerBytes + layout.dims.count() * sizeOf(layout.type);
-  if (ec) throw ReadError("cannot read '" + path + "': " + ec.message());
   if (size != expected) {
     std::ostringstream msg;
     msg << "raw file '" << path << "' has " << size << " bytes, but " << layout.dims.nx << "x"
@@ -69,6 +70,18 @@ AnyVolume readRawVolume(const std::string& path, const RawLayout& layout) {
     msg << " need " << expected << (size < expected ? " (truncated file?)" : "");
     throw ReadError(msg.str());
   }
+}
+
+}  // namespace detail
+
+AnyVolume readRawVolume(const std::string& path, const RawLayout& layout) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
+  if (!fs::is_regular_file(path, ec)) throw ReadError("cannot read '" + path + "': not a regular file");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw ReadError("cannot read '" + path + "': " + ec.message());
+  detail::requireRawLayout(path, layout, size);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ReadError("cannot open '" + path + "': " + std::strerror(errno));
   return visitScalarType(layout.type, [&](auto v) { return readRawAs<decltype(v)>(in, path, layout); });

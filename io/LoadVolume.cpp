@@ -1,0 +1,269 @@
+// loadVolume and loadRawVolume (io/LoadVolume.h): find where a file keeps its voxels, then map
+// them in place, or read them, or let ITK decode them.
+//
+// Who reads what. The strict parsers of io/VolumeHeader.h find the data file, the byte offset
+// of the first voxel, the voxel type, the dimensions, the byte order and whether the voxels are
+// stored raw — what ITK does not expose. ITK reads the same header for the geometry, through
+// the same ImageIO and itk::ImageFileReader as readVolume (io/Internal.h, readItkHeader), and
+// the mapping is made only if ITK agrees on the type, the dimensions and the byte order.
+// Parsing the geometry here too would mean re-deriving, to 1e-9, what ITK does with each
+// format — NIfTI's choice between qform and sform and its RAS-to-LPS flip, NRRD's spaces and
+// space directions, MetaImage's TransformMatrix (stored by columns) — and every ITK release
+// that changes one of them would make loadVolume and readVolume disagree. Asking ITK costs one
+// header read (well under a millisecond) and makes the mapped and decoded paths give the same
+// ImageGeometry by construction. The parsers still check the geometry fields' syntax, so that
+// a malformed header is a clear error before ITK sees it, and they alone decide where the
+// voxels are, so nothing is mapped that ITK would decode differently (scaled NIfTI voxels,
+// NRRD line skips, MetaImage channels: all go to ITK).
+//
+// NaN in NIfTI. niftilib, which ITK's NIfTI reader is built on, replaces NaN and infinite
+// float32/float64 voxels with 0 as it reads them. A view in place cannot, so a float .nii is
+// scanned once when it is loaded (a sequential read of the mapping, no copy) and decoded by ITK
+// if it holds any: float NIfTI volumes are mapped but not lazy.
+//
+// Alignment. The engine reads a view's voxels as a T*, which must be aligned to sizeof(T). A
+// mapping starts on a page, so voxels at a file offset that is not a multiple of sizeof(T) (an
+// .mha or .nrrd whose text header has an odd length, say) cannot be viewed in place; they are
+// read into one aligned buffer instead (decodeReason says so). NIfTI-1's vox_offset (352) and
+// detached data files (offset 0) are always aligned.
+#include "LoadVolume.h"
+
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+
+#include "Deflate.h"
+#include "HeaderText.h"
+#include "Internal.h"
+#include "MappedFile.h"
+#include "VolumeHeader.h"
+
+namespace surftrack::io {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using Parse = std::optional<DataLayout> (*)(std::string_view, std::uint64_t);
+
+struct Format {
+  std::string_view suffix;
+  std::string_view name;
+  Parse parse;
+};
+
+constexpr Format kFormats[] = {{".mha", "mha", parseMetaImageHeader},
+                               {".mhd", "mhd", parseMetaImageHeader},
+                               {".nrrd", "nrrd", parseNrrdHeader},
+                               {".nhdr", "nhdr", parseNrrdHeader},
+                               {".nii", "nii", parseNifti1Header}};
+
+const Format* formatOf(const std::string& path) {
+  std::string name = fs::path(path).filename().string();
+  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+  for (const Format& f : kFormats)
+    if (name.size() >= f.suffix.size() && name.compare(name.size() - f.suffix.size(), f.suffix.size(), f.suffix) == 0)
+      return &f;
+  return nullptr;
+}
+
+std::string quoted(const std::string& path) { return "'" + path + "'"; }
+
+/// A data file named by a header: relative to the header's directory unless absolute.
+std::string dataPath(const std::string& header, const std::string& dataFile) {
+  const fs::path data = dataFile;
+  return data.is_relative() ? (fs::path(header).parent_path() / data).string() : data.string();
+}
+
+/// The header of `file`: its first 4 KiB, then 8 times more until the parser finds its end.
+DataLayout readLayout(const detail::OpenFile& file, Parse parse, const std::string& path) {
+  for (std::size_t n = 4096;; n *= 8) {
+    n = std::min(n, kMaxHeaderBytes);
+    const std::string head = file.head(n);
+    // A file that shrank since it was opened: parse what there is.
+    const std::uint64_t size = head.size() < std::min<std::uint64_t>(n, file.size()) ? head.size() : file.size();
+    try {
+      if (auto layout = parse(head, size)) return *layout;
+    } catch (const HeaderError& e) {
+      throw ReadError("cannot read " + quoted(path) + ": " + e.what());
+    }
+    if (n >= kMaxHeaderBytes)
+      throw ReadError("cannot read " + quoted(path) + ": its header does not end within its first " +
+                      std::to_string(kMaxHeaderBytes >> 20) + " MiB");
+  }
+}
+
+void swapBytes(void* data, std::size_t count, std::size_t size) {
+  auto* p = static_cast<unsigned char*>(data);
+  for (std::size_t i = 0; i < count; ++i, p += size) std::reverse(p, p + size);
+}
+
+/// The voxels [offset, offset + nx ny nz sizeof(type)) of `file`, mapped in place when they
+/// are aligned and need no byte swap, read into one buffer (and swapped) otherwise.
+LoadedVolume viewVoxels(const detail::OpenFile& file, std::uint64_t offset, ScalarType type, Dims dims,
+                        const ImageGeometry& geometry, bool swap) {
+  LoadedVolume out;
+  const std::size_t size = sizeOf(type);
+  out.dataBytes = dims.count() * size;
+  if (swap) {
+    out.decodeReason = "its voxels are big-endian (read and byte-swapped)";
+  } else if (offset % size != 0) {
+    out.decodeReason = "its voxels at byte " + std::to_string(offset) + " are not aligned to their " +
+                       std::to_string(size) + "-byte " + toString(type) + " values (read into memory)";
+  } else {
+    std::string why;
+    out.owner = file.map(offset, out.dataBytes, why);
+    out.mapped = out.owner != nullptr;
+    if (!out.mapped) out.decodeReason = why + " (read into memory)";
+  }
+  if (!out.mapped) {
+    std::shared_ptr<void> buffer = file.read(offset, out.dataBytes);
+    if (swap) swapBytes(buffer.get(), dims.count(), size);
+    out.owner = std::move(buffer);
+  }
+  out.view = VolumeView{out.owner.get(), type, dims,
+                        {1, std::ptrdiff_t(dims.nx), std::ptrdiff_t(dims.nx) * dims.ny}, geometry};
+  return out;
+}
+
+/// ITK decodes the file once; the LoadedVolume views ITK's buffer.
+LoadedVolume decodedByItk(const std::string& path, std::string format, std::string reason) {
+  LoadedVolume out = detail::decodeWithItk(path);
+  if (!format.empty()) out.format = std::move(format);
+  if (reason.empty())
+    reason = out.format == "nii.gz" ? "it is gzip-compressed" : "ITK decodes " + out.format + " files";
+  out.decodeReason = std::move(reason) + " (decoded by ITK)";
+  return out;
+}
+
+/// Whether a dense float or double view holds a NaN or an infinity (all exponent bits set).
+bool hasNonFinite(const VolumeView& v) {
+  const auto* p = static_cast<const unsigned char*>(v.data);
+  const std::size_t n = v.dims.count();
+  bool found = false;
+  if (v.type == ScalarType::Float32) {
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint32_t bits;
+      std::memcpy(&bits, p + 4 * i, 4);
+      found |= (bits & 0x7f800000u) == 0x7f800000u;
+    }
+  } else if (v.type == ScalarType::Float64) {
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint64_t bits;
+      std::memcpy(&bits, p + 8 * i, 8);
+      found |= (bits & 0x7ff0000000000000ull) == 0x7ff0000000000000ull;
+    }
+  }
+  return found;
+}
+
+std::string dimsText(Dims d) {
+  return std::to_string(d.nx) + "x" + std::to_string(d.ny) + "x" + std::to_string(d.nz);
+}
+
+}  // namespace
+
+std::uintmax_t LoadedVolume::residentBytes() const {
+  return mapped ? detail::residentBytes(view.data, dataBytes) : dataBytes;
+}
+
+LoadedVolume loadVolume(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw ReadError("cannot read " + quoted(path) + ": no such file");
+  const Format* format = formatOf(path);
+  if (!format || fs::is_directory(path, ec)) return decodedByItk(path, "", "");
+  try {
+    const detail::OpenFile file(path, "cannot read " + quoted(path));
+    if (file.size() == 0) throw ReadError("cannot read " + quoted(path) + ": the file is empty");
+    const DataLayout layout = readLayout(file, format->parse, path);
+    const std::string name(format->name);
+    if (!layout.decodeReason.empty()) {
+      // Before ITK sees a detached header: its one data file is a regular file (not a FIFO
+      // that would block, not a device) holding enough encoded bytes for the voxels.
+      std::optional<detail::OpenFile> separate;
+      if (!layout.dataFile.empty() && !layout.severalDataFiles) {
+        const std::string data = dataPath(path, layout.dataFile);
+        separate.emplace(data, "cannot read " + quoted(path) + ": its data file " + quoted(data));
+        try {  // (the whole file: a byte skip may count decoded bytes)
+          text::requireStored(layout.dataBytes(), layout.maxExpansion, separate->size());
+        } catch (const HeaderError& e) {
+          throw ReadError(separate->context() + ": " + e.what());
+        }
+      }
+      // A MetaImage's compressed voxels: inflated once here, so that a corrupt stream is an
+      // error (ITK 5.2's MetaIO reports none, and may never return), where MetaIO reads it —
+      // CompressedDataSize bytes from the voxels' offset, or without it the whole file.
+      if (layout.deflated && (separate || layout.dataFile.empty())) {
+        const detail::OpenFile& data = separate ? *separate : file;
+        const std::uint64_t bytes = layout.dataBytes();
+        std::uint64_t start = 0, length = data.size();
+        if (layout.deflatedBytes > 0) {
+          start = layout.fromEnd ? (data.size() >= bytes ? data.size() - bytes : 0) : layout.offset;
+          length = layout.deflatedBytes;
+        }
+        detail::requireDeflated(data, start, length, bytes);
+      }
+      return decodedByItk(path, name, layout.decodeReason);
+    }
+    if (std::endian::native != std::endian::little && sizeOf(layout.type) > 1)
+      return decodedByItk(path, name, "its voxels are little-endian, this machine is not");
+
+    // The file that holds the voxels, and their offset in it.
+    std::optional<detail::OpenFile> separate;
+    if (!layout.dataFile.empty()) {
+      const std::string data = dataPath(path, layout.dataFile);
+      separate.emplace(data, "cannot read " + quoted(path) + ": its data file " + quoted(data));
+    }
+    const detail::OpenFile& data = separate ? *separate : file;
+    const std::uint64_t bytes = layout.dataBytes();
+    std::uint64_t offset = layout.offset;
+    if (separate) {  // (the parsers checked the size of the header's own file)
+      if (layout.fromEnd) offset = data.size() >= bytes ? data.size() - bytes : 0;
+      if (offset > data.size() || data.size() - offset < bytes)
+        throw ReadError(data.context() + " has " + std::to_string(data.size()) + " bytes, but the header announces " +
+                        std::to_string(bytes) + " bytes of voxel data at byte " + std::to_string(offset) +
+                        " (truncated file?)");
+    }
+
+    // The geometry, as readVolume reads it; map only if ITK sees the same voxels.
+    const detail::ItkHeader itk = detail::readItkHeader(path);
+    std::string disagreement;
+    if (itk.type != layout.type)
+      disagreement = "ITK reads its voxels as " + toString(itk.type) + ", not " + toString(layout.type);
+    else if (itk.dims != layout.dims)
+      disagreement = "ITK reads it as " + dimsText(itk.dims) + " voxels, not " + dimsText(layout.dims);
+    else if (sizeOf(layout.type) > 1 && itk.byteOrder == detail::ItkHeader::ByteOrder::Big)
+      disagreement = "ITK reads its voxels as big-endian";
+    if (!disagreement.empty()) return decodedByItk(path, name, disagreement);
+
+    LoadedVolume out = viewVoxels(data, offset, layout.type, layout.dims, itk.geometry, /*swap=*/false);
+    out.format = name;
+    // NIfTI floats: readVolume reads NaN and infinity as 0 (niftilib). One pass over the
+    // voxels, without a copy, tells whether the file has any; if so, ITK decodes it as readVolume.
+    if (layout.nonFiniteReadAsZero && hasNonFinite(out.view))
+      return decodedByItk(path, name, "its float voxels include NaN or infinite values, which NIfTI readers read as 0");
+    return out;
+  } catch (const std::bad_alloc&) {
+    throw ReadError("cannot read " + quoted(path) + ": out of memory");
+  }
+}
+
+LoadedVolume loadRawVolume(const std::string& path, const RawLayout& layout) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw ReadError("cannot read " + quoted(path) + ": no such file");
+  try {
+    const detail::OpenFile file(path, "cannot read " + quoted(path));
+    detail::requireRawLayout(path, layout, file.size());
+    const bool swap = sizeOf(layout.type) > 1 && layout.bigEndian != (std::endian::native == std::endian::big);
+    LoadedVolume out = viewVoxels(file, layout.headerBytes, layout.type, layout.dims, layout.geometry, swap);
+    out.format = "raw";
+    return out;
+  } catch (const std::bad_alloc&) {
+    throw ReadError("cannot read " + quoted(path) + ": out of memory");
+  }
+}
+
+}  // namespace surftrack::io

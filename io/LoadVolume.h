@@ -1,0 +1,71 @@
+// Volumes for the engine without a copy: a VolumeView of the voxels where they already are, and
+// what keeps that memory alive.
+//
+// An uncompressed volume whose voxels are stored little-endian (this machine's order) with x
+// fastest — a raw file, a MetaImage (.mha, .mhd + its data file), a NRRD (.nrrd, .nhdr + its
+// data file, "encoding: raw") or a NIfTI-1 image (.nii) — is memory-mapped read-only and viewed
+// in place: opening it reads its header, not its voxels; the pages of voxels the engine
+// touches are read from the file when it touches them, and the kernel may drop them again
+// under memory pressure. (Voxels at a file offset that is not a multiple of their size — after
+// an .mha or .nrrd text header of odd length, say — cannot be viewed as the T* the engine reads:
+// they are read into one aligned buffer instead.) Any other volume (gzip'd .nii.gz, compressed NRRD or MetaImage,
+// big-endian multi-byte voxels, DICOM, TIFF, VTK, NIfTI-2, ...) is decoded once by ITK into
+// ITK's own buffer, which is viewed in place; byte-swapped raw files are read and swapped into
+// one buffer. In both cases the geometry and the voxel values are what readVolume gives for
+// the same file — which is why a float32/float64 .nii, whose NaN and infinite voxels ITK's
+// NIfTI reader (niftilib) reads as 0, is read through once when loaded, to look for them (and
+// decoded by ITK if it has any): those files are mapped but not lazy.
+//
+// A mapped file must not shrink while it is mapped: the size is checked before mapping and
+// again just after, but a file truncated later (by another process) makes the next access to
+// a lost page raise SIGBUS, which ends the process — surftrack installs no signal handler. Read
+// files that other programs may rewrite in place with readVolume (a copy) instead.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "ReadVolume.h"
+#include "VolumeView.h"
+
+namespace surftrack::io {
+
+/// A volume ready for the engine: a view of its voxels and what keeps their memory alive.
+/// Copies share the memory; the view stays valid as long as one copy of `owner` lives (even
+/// after the file is deleted: a mapping outlives its file's name).
+struct LoadedVolume {
+  VolumeView view;                    ///< data, type, dims, strides (x fastest), geometry
+  std::shared_ptr<const void> owner;  ///< the mapping, or the decoded buffer (owner.get() == view.data)
+  bool mapped = false;                ///< true: the file is memory-mapped, pages are read on demand
+  std::string format;  ///< "raw", "mha", "mhd", "nrrd", "nhdr", "nii", "nii.gz", "dicom", "tiff", "vtk", ...
+  std::uintmax_t dataBytes = 0;  ///< bytes of voxel data (nx ny nz sizeof(type); decompressed size if compressed)
+  /// Why the voxels were decoded or read rather than mapped in place (empty when mapped):
+  /// "its voxels are gzip-encoded", "its voxels at byte 301 are not aligned to their 2-byte
+  /// int16 values", ...
+  std::string decodeReason;
+
+  /// Bytes of voxel data resident in memory now: for a mapping, the pages that mincore()
+  /// reports resident — on Linux that is the file's pages in the page cache, whether or not
+  /// this process has touched them, so a file just written or read by anyone counts as
+  /// resident until the kernel evicts it; what the figure says is how much of the volume the
+  /// engine can read without waiting for the disk. dataBytes when decoded (the buffer is
+  /// ordinary memory), 0 if mincore() fails.
+  std::uintmax_t residentBytes() const;
+};
+
+/// Loads a volume, the format from the file name: .mha, .mhd, .nrrd, .nhdr and .nii are
+/// mapped when they can be (their headers read by this library's own strict parsers, their
+/// geometry by ITK), anything else ITK reads (see readVolume), including a directory holding
+/// one DICOM series. Throws ReadError with one line naming the file: missing, unreadable,
+/// malformed header, a file shorter than its header announces ("truncated file?"), unsupported
+/// voxel type.
+LoadedVolume loadVolume(const std::string& path);
+
+/// Loads a headerless raw file (see RawLayout). The file must hold exactly headerBytes +
+/// nx ny nz sizeof(type) bytes. Mapped when its voxels are little-endian (or one byte each) and
+/// headerBytes is a multiple of the voxel size; read into one buffer (and byte-swapped)
+/// otherwise. Throws ReadError, with readRawVolume's messages.
+LoadedVolume loadRawVolume(const std::string& path, const RawLayout& layout);
+
+}  // namespace surftrack::io

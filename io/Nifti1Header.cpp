@@ -1,0 +1,175 @@
+// The NIfTI-1 header (nifti1.h, "NIFTI-1 Data Format"): 348 bytes in the byte order of the
+// writer (sizeof_hdr = 348 tells which), the voxels of a single-file image (magic "n+1") at
+// byte vox_offset of the same file. Fields read here: sizeof_hdr (0), dim[8] (40), datatype
+// (70), vox_offset (108), scl_slope (112), scl_inter (116), magic (344); the geometry (pixdim
+// at 76, qform_code 252, sform_code 254, quatern_b..qoffset_z 256, srow_x..z 280) is ITK's to
+// read, and only checked to be finite here.
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "HeaderText.h"
+#include "VolumeHeader.h"
+
+namespace surftrack::io {
+
+namespace {
+
+constexpr std::size_t kHeaderSize = 348;
+
+/// NIfTI-1 datatype codes of the ten scalar types (nifti1.h, DT_*).
+std::optional<ScalarType> niftiType(int datatype) {
+  switch (datatype) {
+    case 2: return ScalarType::UInt8;      // DT_UINT8
+    case 256: return ScalarType::Int8;     // DT_INT8
+    case 4: return ScalarType::Int16;      // DT_INT16
+    case 512: return ScalarType::UInt16;   // DT_UINT16
+    case 8: return ScalarType::Int32;      // DT_INT32
+    case 768: return ScalarType::UInt32;   // DT_UINT32
+    case 1024: return ScalarType::Int64;   // DT_INT64
+    case 1280: return ScalarType::UInt64;  // DT_UINT64
+    case 16: return ScalarType::Float32;   // DT_FLOAT32
+    case 64: return ScalarType::Float64;   // DT_FLOAT64
+    default: return std::nullopt;
+  }
+}
+
+class Reader {
+ public:
+  Reader(std::string_view head, bool swapped) : head_(head), swapped_(swapped) {}
+
+  template <class T>
+  T get(std::size_t at) const {
+    unsigned char b[sizeof(T)];
+    std::memcpy(b, head_.data() + at, sizeof(T));  // the callers check at + sizeof(T) <= head_.size()
+    if (swapped_)
+      for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+    T v;
+    std::memcpy(&v, b, sizeof(T));
+    return v;
+  }
+
+ private:
+  std::string_view head_;
+  bool swapped_;
+};
+
+}  // namespace
+
+std::optional<DataLayout> parseNifti1Header(std::string_view head, std::uint64_t fileSize) {
+  if (head.size() < kHeaderSize) {
+    if (head.size() < fileSize) return std::nullopt;
+    throw HeaderError("the file has " + std::to_string(fileSize) +
+                      " bytes, fewer than a NIfTI-1 header (348 bytes) (truncated file?)");
+  }
+  DataLayout layout;
+  const std::int32_t sizeofHdr = Reader(head, false).get<std::int32_t>(0);
+  const std::int32_t swappedSize = Reader(head, true).get<std::int32_t>(0);
+  const bool swapped = sizeofHdr != 348 && swappedSize == 348;
+  if (sizeofHdr == 540 || swappedSize == 540) {
+    // NIfTI-2 (nifti2.h) is ITK's to read; its geometry, doubles, is checked as NIfTI-1's below:
+    // pixdim[0..3] at 104, qform_code at 344 and quatern_b..qoffset_z at 352, sform_code at 348
+    // and srow_x..srow_z at 400.
+    constexpr std::size_t kNifti2Size = 540;
+    if (head.size() < kNifti2Size) {
+      if (head.size() < fileSize) return std::nullopt;
+      throw HeaderError("the file has " + std::to_string(fileSize) +
+                        " bytes, fewer than a NIfTI-2 header (540 bytes) (truncated file?)");
+    }
+    const Reader r2(head, sizeofHdr != 540);
+    // A NIfTI-2 header starts its magic at byte 4. ITK 5.2's niftilib reads NIfTI-1 only and
+    // goes by the NIfTI-1 magic at byte 344: a 540-byte size with that magic is read as NIfTI-1
+    // (and a NaN in its NIfTI-1 sform aborts the process), so it is refused here.
+    const std::string_view magic2 = head.substr(4, 4);
+    if (magic2 != std::string_view("n+2\0", 4) && magic2 != std::string_view("ni2\0", 4))
+      throw HeaderError("malformed NIfTI header: its size (sizeof_hdr 540) is NIfTI-2's, but its magic is not "
+                        "'n+2' or 'ni2'");
+    auto requireFinite2 = [&](std::size_t at, int count, const char* field) {
+      for (int i = 0; i < count; ++i)
+        if (!(std::abs(r2.get<double>(at + 8 * std::size_t(i))) <= text::kMaxGeometryValue))
+          throw HeaderError(std::string("malformed NIfTI-2 header: ") + field + " is not finite (or beyond 1e15)");
+    };
+    requireFinite2(104, 4, "pixdim");
+    if (r2.get<std::int32_t>(344) > 0) requireFinite2(352, 6, "the qform (quatern_b to qoffset_z)");
+    if (r2.get<std::int32_t>(348) > 0) requireFinite2(400, 12, "the sform (srow_x to srow_z)");
+    layout.decodeReason = "it is a NIfTI-2 file";
+    return layout;
+  }
+  if (sizeofHdr != 348 && !swapped)
+    throw HeaderError("not a NIfTI-1 file: its header size (sizeof_hdr) is " + std::to_string(sizeofHdr) +
+                      ", not 348");
+  const Reader r(head, swapped);
+  // The geometry fields ITK turns into a matrix (and ITK's SVD aborts the process on a NaN or
+  // an infinity): pixdim[0..3] always, quatern_b..qoffset_z when qform_code > 0, srow_x..srow_z
+  // when sform_code > 0; finite and within +-1e15 (text::kMaxGeometryValue).
+  auto requireFinite = [&](std::size_t at, int count, const char* field) {
+    for (int i = 0; i < count; ++i)
+      if (!(std::abs(r.get<float>(at + 4 * std::size_t(i))) <= text::kMaxGeometryValue))
+        throw HeaderError(std::string("malformed NIfTI-1 header: ") + field + " is not finite (or beyond 1e15)");
+  };
+  requireFinite(76, 4, "pixdim");
+  if (r.get<std::int16_t>(252) > 0) requireFinite(256, 6, "the qform (quatern_b to qoffset_z)");
+  if (r.get<std::int16_t>(254) > 0) requireFinite(280, 12, "the sform (srow_x to srow_z)");
+
+  // Without the magic, niftilib (readVolume) reads the header as Analyze 7.5 and makes up
+  // voxels it does not find: a .nii must say "n+1", or "ni1" for voxels in a separate .img file
+  // (NIfTI-1, magic).
+  const std::string_view magic = head.substr(344, 4);
+  const bool separate = magic == std::string_view("ni1\0", 4);
+  if (!separate && magic != std::string_view("n+1\0", 4))
+    throw HeaderError("not a NIfTI-1 file: its magic is not 'n+1' (an Analyze 7.5 header in a .nii file?)");
+
+  const int ndim = r.get<std::int16_t>(40);
+  if (ndim < 1 || ndim > 7)
+    throw HeaderError("malformed NIfTI-1 header: dim[0] is " + std::to_string(ndim) + ", not 1 to 7");
+  std::vector<std::int64_t> sizes;
+  for (int d = 1; d <= ndim; ++d) {
+    const int n = r.get<std::int16_t>(40 + 2 * d);
+    if (n < 1)
+      throw HeaderError("malformed NIfTI-1 header: dim[" + std::to_string(d) + "] is " + std::to_string(n));
+    sizes.push_back(n);
+  }
+  layout.dims = {int(sizes[0]), ndim > 1 ? int(sizes[1]) : 1, ndim > 2 ? int(sizes[2]) : 1};
+  auto because = [&](const std::string& reason) {
+    if (layout.decodeReason.empty()) layout.decodeReason = reason;
+  };
+  if (separate) because("its voxels are in a separate .img file (magic 'ni1')");
+  for (int d = 4; d <= ndim; ++d)
+    if (sizes[d - 1] != 1) because("it has more than one volume (dim[" + std::to_string(d) + "] > 1)");
+
+  const int datatype = r.get<std::int16_t>(70);
+  const auto type = niftiType(datatype);
+  if (!type) {
+    because("its NIfTI datatype is " + std::to_string(datatype));
+    return layout;
+  }
+  layout.type = *type;
+  // niftilib's nifti_read_buffer sets non-finite float32 and float64 voxels to 0.
+  layout.nonFiniteReadAsZero = *type == ScalarType::Float32 || *type == ScalarType::Float64;
+  layout.bigEndian = swapped && sizeOf(*type) > 1;
+  if (layout.bigEndian) because("its voxels are big-endian");
+
+  // scl_slope = 0 means no scaling; ITK rescales (and may change the voxel type) otherwise.
+  const float slope = r.get<float>(112), inter = r.get<float>(116);
+  if (slope != 0 && (slope != 1 || inter != 0)) because("its voxels are scaled (scl_slope, scl_inter)");
+
+  const float voxOffset = r.get<float>(108);
+  if (!(voxOffset >= 0) || !std::isfinite(voxOffset))
+    throw HeaderError("malformed NIfTI-1 header: vox_offset is not a byte offset");
+  if (voxOffset < 352 || voxOffset != std::floor(voxOffset)) {
+    because("its vox_offset is " + std::to_string(voxOffset) + " (a .nii file needs an integer >= 352)");
+    return layout;
+  }
+  text::requireSizes(sizes, sizeOf(*type));
+  if (separate) return layout;  // (the voxels are not in this file)
+  if (double(voxOffset) > double(fileSize))
+    throw HeaderError("the file has " + std::to_string(fileSize) + " bytes, but its header puts the voxels at byte " +
+                      std::to_string(voxOffset) + " (truncated file?)");
+  layout.offset = std::uint64_t(voxOffset);
+  text::requireData(layout.offset, layout.dataBytes(), fileSize);
+  return layout;
+}
+
+}  // namespace surftrack::io
