@@ -67,9 +67,10 @@ Extraction extract(const io::AnyVolume& volume, const std::string& inputName, co
   Progress progress(Progress::wanted(out.quiet));
   StageClock clock;
   x.timings.push_back({"read", readSeconds});
-  describeInput(volume, inputName, x);
+  const io::LoadedVolume loaded = inMemory(volume);
+  describeInput(loaded, inputName, x);
   const int stages = extractionStages(options) + 1;  // + write
-  extractSurface(volume, options, x, clock, progress, 0, stages);
+  extractSurface(loaded.view, options, x, clock, progress, 0, stages);
   progress.stage(stages - 1, stages, "writing " + output);
   x.bytes = writeMeshFile(x.mesh, output, x.binary);
   clock.lap(x.timings, "write");

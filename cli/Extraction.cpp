@@ -20,13 +20,6 @@ std::string formatNumber(double v) {
   return s.str();
 }
 
-/// The core's view of a volume read by io/ (no copy).
-VolumeView viewOf(const io::AnyVolume& volume) {
-  return std::visit(
-      [](const auto& image) { return VolumeView::of(image.data().data(), image.dims(), image.geometry()); },
-      volume);
-}
-
 SeedRule seedRuleOf(const SurfaceOptions& o) {
   switch (o.seedMode) {
     case SeedMode::All: return SeedRule::all();
@@ -50,20 +43,33 @@ std::string stageText(const std::string& stage) {
 
 }  // namespace
 
-void describeInput(const io::AnyVolume& volume, const std::string& path, Extraction& x) {
+void describeInput(const io::LoadedVolume& volume, const std::string& path, Extraction& x) {
   x.input = path;
-  x.dims = io::dimsOf(volume);
-  x.type = io::scalarTypeOf(volume);
-  x.geometry = io::geometryOf(volume);
+  x.dims = volume.view.dims;
+  x.type = volume.view.type;
+  x.geometry = volume.view.geometry;
+  x.storage = volume.format.empty() ? std::string("in memory")
+                                    : (volume.mapped ? "memory-mapped " : "loaded ") + volume.format;
+  x.mapped = volume.mapped;
+  x.decodeReason = volume.decodeReason;
+  x.voxelBytes = volume.view.dims.count() * sizeOf(volume.view.type);
 }
 
-io::AnyVolume readInput(const InputOptions& input) {
-  io::AnyVolume volume = input.raw ? io::readRawVolume(input.path, input.rawLayout)
-                                   : io::readVolume(input.path);
-  ImageGeometry& g = io::geometryOf(volume);
+io::LoadedVolume readInput(const InputOptions& input) {
+  io::LoadedVolume volume = input.raw ? io::loadRawVolume(input.path, input.rawLayout)
+                                      : io::loadVolume(input.path);
+  ImageGeometry& g = volume.view.geometry;
   if (input.spacing) g.spacing = *input.spacing;
   if (input.origin) g.origin = *input.origin;
   return volume;
+}
+
+io::LoadedVolume inMemory(const io::AnyVolume& volume) {
+  io::LoadedVolume loaded;
+  loaded.view = std::visit(
+      [](const auto& image) { return VolumeView::of(image.data().data(), image.dims(), image.geometry()); },
+      volume);
+  return loaded;
 }
 
 int extractionStages(const SurfaceOptions& o) { return o.seedMode == SeedMode::All ? 5 : 7; }
@@ -71,7 +77,7 @@ int extractionStages(const SurfaceOptions& o) { return o.seedMode == SeedMode::A
 namespace {
 
 /// The values of `volume`, for Otsu's default or for an error message.
-VolumeStats valueStats(const io::AnyVolume& volume, const Extraction& x) {
+VolumeStats valueStats(const VolumeView& volume, const Extraction& x) {
   VolumeStats stats = computeStats(volume);
   if (stats.voxels == 0)
     throw std::runtime_error("'" + x.input + "' holds no finite value: nothing to extract");
@@ -80,7 +86,7 @@ VolumeStats valueStats(const io::AnyVolume& volume, const Extraction& x) {
 
 /// After the front door found no surface: the message, made precise by the data's values (an
 /// O(volume) pass, paid only on this error path and by Otsu's default).
-[[noreturn]] void explainNoSurface(const io::AnyVolume& volume, const Extraction& x,
+[[noreturn]] void explainNoSurface(const VolumeView& volume, const Extraction& x,
                                    const std::string& message) {
   const VolumeStats stats = valueStats(volume, x);
   const std::string range = "[" + formatNumber(stats.min) + ", " + formatNumber(stats.max) + "]";
@@ -120,7 +126,7 @@ VolumeStats valueStats(const io::AnyVolume& volume, const Extraction& x) {
 
 }  // namespace
 
-void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extraction& x,
+void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extraction& x,
                     StageClock& clock, Progress& progress, int stage, int stageCount) {
   progress.stage(stage, stageCount, "choosing the voxels");
   x.pair = o.pair;
@@ -171,7 +177,7 @@ void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extrac
   if (o.seedMode == SeedMode::Point) x.seedPoint = o.seedPoint;
   Surface surface;
   try {
-    surface = extract(viewOf(volume), eo);
+    surface = extract(volume, eo);
   } catch (const InvalidInput& e) {
     explainNoSurface(volume, x, e.what());
   }
@@ -187,15 +193,17 @@ void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extrac
   x.walkSteps = surface.seed.walkSteps;
   x.boundaries = surface.boundariesInImage;
   x.surfels = surface.surfels.size();
+  x.voxelBytesRead = x.mapped ? std::min<std::uintmax_t>(surface.voxelsRead * sizeOf(volume.type), x.voxelBytes)
+                             : x.voxelBytes;
 
   progress.stage(stage + extractionStages(o) - 1, stageCount, "building the mesh");
   TriangleMesh triangles{std::move(surface.surfels), std::move(surface.triangles)};
-  x.mesh = toSurfaceMesh(triangles, surface.vertices);
-  x.stats = computeMeshStats(x.mesh);
-  for (std::size_t c = 0; c < x.stats.components.size() && c < surface.components.size(); ++c) {
-    x.stats.components[c].area = surface.components[c].area;
-    x.stats.components[c].volume = surface.components[c].volume;
+  try {
+    x.mesh = toSurfaceMesh(triangles, surface.vertices);  // checks the closed oriented manifold
+  } catch (const std::logic_error& e) {
+    throw InternalError(e.what());
   }
+  x.stats = meshStats(surface, x.mesh);
   clock.lap(x.timings, "mesh");
 }
 

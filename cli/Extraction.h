@@ -13,8 +13,10 @@
 #include "MeshStats.h"
 #include "Options.h"
 #include "Progress.h"
+#include "LoadVolume.h"
 #include "ReadVolume.h"
 #include "SurfaceMesh.h"
+#include "VolumeView.h"
 
 namespace surftrack::cli {
 
@@ -53,6 +55,17 @@ struct Extraction {
   /// The data range, when it was computed (Otsu's default); a seeded extraction never reads
   /// every voxel to find it.
   std::optional<std::array<double, 2>> dataRange;
+  /// How the voxels are held: memory-mapped from the file (read on demand) or decoded once.
+  std::string storage;            ///< "memory-mapped mha", "loaded nii.gz", "in memory", ...
+  bool mapped = false;            ///< memory-mapped: only the pages the engine touches are read
+  std::string decodeReason;       ///< why the file was loaded whole rather than mapped
+  std::uintmax_t voxelBytes = 0;  ///< nx ny nz sizeof(type)
+  /// Bytes of voxels read: all of them when loaded whole; when mapped, those the engine asked
+  /// for (Surface::voxelsRead, at most voxelBytes).
+  std::uintmax_t voxelBytesRead = 0;
+  /// Mapped: bytes of the file's voxels in memory after the extraction (the kernel reads whole
+  /// pages and reads ahead; pages cached by earlier readers count too).
+  std::optional<std::uintmax_t> voxelBytesResident;
 
   // The binary image and the surface options.
   bool byLabel = false;
@@ -95,14 +108,19 @@ int extractionStages(const SurfaceOptions& options);
 /// reports progress stages stage .. stage + extractionStages(options) - 1 of stageCount. Throws std::runtime_error with a one-line
 /// message for an iso-value outside the data range, a label absent from the image, a seed
 /// outside the domain or on no boundary, an empty selection.
-void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& options,
+void extractSurface(const VolumeView& volume, const SurfaceOptions& options,
                     Extraction& extraction, StageClock& clock, Progress& progress,
                     int stageOffset, int stageCount);
 
 /// Fills the input fields of `extraction` from `volume`.
-void describeInput(const io::AnyVolume& volume, const std::string& path, Extraction& extraction);
+void describeInput(const io::LoadedVolume& volume, const std::string& path, Extraction& extraction);
 
-/// Reads the volume of `input` (ITK or raw) and applies the geometry overrides.
-io::AnyVolume readInput(const InputOptions& input);
+/// Loads the volume of `input` (memory-mapped when it can be, else decoded once; raw files by
+/// their stated layout) and applies the geometry overrides.
+io::LoadedVolume readInput(const InputOptions& input);
+
+/// A volume in memory (the demo's phantom, the MRI it reads) as a loaded one, without a copy:
+/// the result refers to `volume`, which must outlive it.
+io::LoadedVolume inMemory(const io::AnyVolume& volume);
 
 }  // namespace surftrack::cli

@@ -12,8 +12,8 @@ namespace surftrack::cli {
 
 int runInfo(const std::vector<std::string>& args) {
   const InfoOptions o = parseInfoOptions(args);
-  const io::AnyVolume volume = readInput(o.input);
-  const VolumeStats stats = computeStats(volume);
+  const io::LoadedVolume volume = readInput(o.input);
+  const VolumeStats stats = computeStats(volume.view);
   if (o.out.json) {
     std::cout << jsonText(volumeJson(o.input.path, volume, stats)) << std::endl;
   } else if (!o.out.quiet) {

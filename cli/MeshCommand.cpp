@@ -22,11 +22,12 @@ int runMesh(const std::vector<std::string>& args) {
   StageClock clock;
   const int stages = extractionStages(o.surface) + 2;  // + read, write
   progress.stage(0, stages, "reading " + o.input.path);
-  const io::AnyVolume volume = readInput(o.input);
+  const io::LoadedVolume volume = readInput(o.input);
   clock.lap(x.timings, "read");
   describeInput(volume, o.input.path, x);
 
-  extractSurface(volume, o.surface, x, clock, progress, 1, stages);
+  extractSurface(volume.view, o.surface, x, clock, progress, 1, stages);
+  if (volume.mapped) x.voxelBytesResident = volume.residentBytes();
 
   progress.stage(stages - 1, stages, "writing " + o.output);
   x.bytes = writeMeshFile(x.mesh, o.output, x.binary);

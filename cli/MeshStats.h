@@ -1,33 +1,30 @@
-// Topology and extent of an output mesh: counts, connected components, Euler characteristic
-// V - E + F and genus g = (2 - chi) / 2 per component, closedness, bounding box.
+// Topology and extent of an output mesh, for the summary: counts, the figures of each connected
+// component (Euler characteristic V - E + F, genus (2 - chi) / 2, area, enclosed volume — the
+// engine's own, Extract.h's ComponentFigures), closedness, bounding box.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <vector>
 
+#include "Extract.h"
 #include "SurfaceMesh.h"
 
 namespace surftrack::cli {
 
-struct ComponentStats {
-  std::size_t vertices = 0, edges = 0, triangles = 0;
-  long long euler = 0;
-  double area = 0, volume = 0;  ///< physical; the volume enclosed (negative: a cavity)
-  /// (2 - chi) / 2: an integer for a closed orientable surface.
-  double genus() const { return (2.0 - double(euler)) / 2.0; }
-};
-
 struct MeshStats {
   std::size_t vertices = 0, edges = 0, triangles = 0;
   long long euler = 0;
-  /// Sorted by decreasing vertex count.
-  std::vector<ComponentStats> components;
+  /// Sorted by decreasing surfel (vertex) count.
+  std::vector<ComponentFigures> components;
   bool closed = false;    ///< no boundary edge
   bool manifold = false;  ///< every vertex has a single fan of triangles
   std::array<double, 3> min{}, max{};  ///< bounding box of the vertices (physical)
 };
 
-MeshStats computeMeshStats(const SurfaceMesh& mesh);
+/// The figures of `surface`, whose half-edge mesh `mesh` is: toSurfaceMesh built it, which
+/// refuses anything but a closed, consistently oriented 2-manifold, so both flags are true
+/// here; the counts come from the mesh, the components from the engine (surface.components).
+MeshStats meshStats(const Surface& surface, const SurfaceMesh& mesh);
 
 }  // namespace surftrack::cli

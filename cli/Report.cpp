@@ -157,10 +157,38 @@ std::string surfelText(const Surfel& s) {
   return "c=" + voxelText(s.inside()) + " d=" + voxelText(s.outside());
 }
 
+namespace {
+
+/// "memory-mapped mha (pages read on demand)" / "loaded nii.gz (its voxels are gzip-encoded ...)".
+std::string storageText(const io::LoadedVolume& v) {
+  if (v.mapped) return "memory-mapped " + v.format + " (pages read on demand)";
+  return "loaded " + v.format + (v.decodeReason.empty() ? "" : " (" + v.decodeReason + ")");
+}
+
+json storageJson(const io::LoadedVolume& v) {
+  json j;
+  j["format"] = v.format;
+  j["mapped"] = v.mapped;
+  if (!v.decodeReason.empty()) j["loaded_because"] = v.decodeReason;
+  j["voxel_bytes"] = v.dataBytes;
+  return j;
+}
+
+}  // namespace
+
 void printSummary(std::ostream& out, const Extraction& x) {
   const MeshStats& m = x.stats;
   out << "surftrack: " << x.input << " -> " << x.output << "\n";
   row(out, "image", imageLine(x.dims, x.type, x.geometry));
+  if (x.voxelBytes) {
+    std::ostringstream s;
+    s << x.storage;
+    if (!x.decodeReason.empty()) s << " (" << x.decodeReason << ")";
+    s << "; voxels read " << bytesText(x.voxelBytesRead) << " of " << bytesText(x.voxelBytes) << " ("
+      << num(100.0 * double(x.voxelBytesRead) / double(x.voxelBytes), 3) << " %)";
+    if (x.voxelBytesResident) s << ", " << bytesText(*x.voxelBytesResident) << " of it in memory";
+    row(out, "input", s.str());
+  }
   {
     std::ostringstream s;
     if (x.dataRange) s << "range [" << num((*x.dataRange)[0]) << ", " << num((*x.dataRange)[1]) << "]; ";
@@ -197,7 +225,7 @@ void printSummary(std::ostream& out, const Extraction& x) {
         s << " " << num(g) << " x" << n;
       }
       if (!m.components.empty())
-        s << "; largest: " << m.components[0].vertices << " vertices, genus " << num(m.components[0].genus());
+        s << "; largest: " << m.components[0].surfels << " vertices, genus " << num(m.components[0].genus());
     }
     s << (m.closed && m.manifold ? "; closed 2-manifold" : m.closed ? "; closed, NOT a manifold" : "; NOT closed");
     row(out, "topology", s.str());
@@ -226,6 +254,16 @@ json extractionJson(const Extraction& x) {
   j["spacing"] = numbers(x.geometry.spacing);
   j["origin"] = numbers(x.geometry.origin);
   j["direction"] = directionJson(x.geometry);
+  {
+    json storage;
+    storage["storage"] = x.storage;
+    storage["mapped"] = x.mapped;
+    if (!x.decodeReason.empty()) storage["loaded_because"] = x.decodeReason;
+    storage["voxel_bytes"] = x.voxelBytes;
+    storage["voxel_bytes_read"] = x.voxelBytesRead;
+    if (x.voxelBytesResident) storage["voxel_bytes_resident"] = *x.voxelBytesResident;
+    j["input_storage"] = std::move(storage);
+  }
   if (x.dataRange) j["data_range"] = {number((*x.dataRange)[0]), number((*x.dataRange)[1])};
   json selection;
   selection["mode"] = x.byLabel ? "label" : "iso";
@@ -265,7 +303,7 @@ json extractionJson(const Extraction& x) {
   for (std::size_t i = 0; i < m.components.size() && i < kListed; ++i) {
     const auto& c = m.components[i];
     json component;
-    component["vertices"] = c.vertices;
+    component["vertices"] = c.surfels;
     component["edges"] = c.edges;
     component["triangles"] = c.triangles;
     component["euler_characteristic"] = c.euler;
@@ -292,18 +330,19 @@ json extractionJson(const Extraction& x) {
   return j;
 }
 
-void printVolumeInfo(std::ostream& out, const std::string& path, const io::AnyVolume& volume,
+void printVolumeInfo(std::ostream& out, const std::string& path, const io::LoadedVolume& volume,
                      const VolumeStats& s) {
-  const Dims& d = io::dimsOf(volume);
-  const ImageGeometry& g = io::geometryOf(volume);
+  const Dims& d = volume.view.dims;
+  const ImageGeometry& g = volume.view.geometry;
   out << "surftrack: " << path << "\n";
   row(out, "size", std::to_string(d.nx) + " x " + std::to_string(d.ny) + " x " + std::to_string(d.nz) +
-                       " = " + std::to_string(d.count()) + " voxels of " + io::toString(io::scalarTypeOf(volume)));
+                       " = " + std::to_string(d.count()) + " voxels of " + io::toString(volume.view.type));
   row(out, "spacing", tripleText(g.spacing));
   row(out, "origin", tripleText(g.origin));
   row(out, "direction", directionText(g));
   std::array<double, 3> far = g.toPhysical({double(d.nx - 1), double(d.ny - 1), double(d.nz - 1)});
   row(out, "extent", "voxel centres from " + tripleText(g.origin) + " to " + tripleText(far));
+  row(out, "storage", storageText(volume));
   {
     std::ostringstream v;
     v << '[' << num(s.min) << ", " << num(s.max) << "], mean " << num(s.mean);
@@ -333,16 +372,17 @@ void printVolumeInfo(std::ostream& out, const std::string& path, const io::AnyVo
   }
 }
 
-json volumeJson(const std::string& path, const io::AnyVolume& volume, const VolumeStats& s) {
-  const Dims& d = io::dimsOf(volume);
-  const ImageGeometry& g = io::geometryOf(volume);
+json volumeJson(const std::string& path, const io::LoadedVolume& volume, const VolumeStats& s) {
+  const Dims& d = volume.view.dims;
+  const ImageGeometry& g = volume.view.geometry;
   json j;
   j["input"] = path;
   j["dims"] = {d.nx, d.ny, d.nz};
-  j["type"] = io::toString(io::scalarTypeOf(volume));
+  j["type"] = io::toString(volume.view.type);
   j["spacing"] = numbers(g.spacing);
   j["origin"] = numbers(g.origin);
   j["direction"] = directionJson(g);
+  j["storage"] = storageJson(volume);
   j["min"] = number(s.min);
   j["max"] = number(s.max);
   j["mean"] = number(s.mean);

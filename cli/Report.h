@@ -8,7 +8,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "Extraction.h"
-#include "ReadVolume.h"
+#include "LoadVolume.h"
 #include "VolumeStats.h"
 
 namespace surftrack::cli {
@@ -20,9 +20,9 @@ void printSummary(std::ostream& out, const Extraction& x);
 nlohmann::ordered_json extractionJson(const Extraction& x);
 
 /// `surftrack info`: the description of a volume.
-void printVolumeInfo(std::ostream& out, const std::string& path, const io::AnyVolume& volume,
+void printVolumeInfo(std::ostream& out, const std::string& path, const io::LoadedVolume& volume,
                      const VolumeStats& stats);
-nlohmann::ordered_json volumeJson(const std::string& path, const io::AnyVolume& volume,
+nlohmann::ordered_json volumeJson(const std::string& path, const io::LoadedVolume& volume,
                                   const VolumeStats& stats);
 
 /// The text --json prints: indented by 2, one value per line, invalid UTF-8 in strings (a

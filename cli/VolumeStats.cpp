@@ -11,23 +11,41 @@ namespace {
 
 constexpr int kBins = 256;
 
+/// Calls f(v) for every voxel value of `view` (of type T), rows of x in memory order.
+template <class T, class F>
+void forEachValue(const VolumeView& view, F&& f) {
+  const T* base = static_cast<const T*>(view.data);
+  const Dims d = view.dims;
+  for (int z = 0; z < d.nz; ++z)
+    for (int y = 0; y < d.ny; ++y) {
+      const T* row = base + z * view.strides[2] + y * view.strides[1];
+      const std::ptrdiff_t sx = view.strides[0];
+      for (int x = 0; x < d.nx; ++x) f(row[x * sx]);
+    }
+}
+
+/// Calls f(T{}) with the type of the view's voxels.
+template <class F>
+decltype(auto) visitView(const VolumeView& view, F&& f) {
+  return visitScalarType(view.type, std::forward<F>(f));
+}
+
 template <class T>
-VolumeStats statsOf(const DenseImage<T>& image) {
+VolumeStats statsOf(const VolumeView& view) {
   VolumeStats s;
   s.integral = std::is_integral_v<T>;
-  const auto& data = image.data();
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0;
-  for (T v : data) {
+  forEachValue<T>(view, [&](T v) {
     const double d = double(v);
     if (!std::isfinite(d)) {
       ++s.nonFinite;
-      continue;
+      return;
     }
     lo = std::min(lo, d);
     hi = std::max(hi, d);
     sum += d;
-  }
-  s.voxels = data.size() - s.nonFinite;
+  });
+  s.voxels = view.dims.count() - s.nonFinite;
   if (s.voxels == 0) {
     s.histogram.assign(kBins, 0);
     return s;
@@ -43,16 +61,16 @@ VolumeStats statsOf(const DenseImage<T>& image) {
   // map: this runs over every voxel), then list them as labels when there are at most 256.
   const bool countValues = s.integral && hi - lo < double(1 << 20);
   std::vector<std::size_t> valueCount(countValues ? std::size_t(hi - lo) + 1 : 0, 0);
-  for (T v : data) {
+  forEachValue<T>(view, [&](T v) {
     const double d = double(v);
-    if (!std::isfinite(d)) continue;
+    if (!std::isfinite(d)) return;
     if (countValues) {
       ++valueCount[std::size_t(d - lo)];
     } else {
       const int b = int((d - lo) / s.binWidth);
       s.histogram[std::clamp(b, 0, kBins - 1)]++;
     }
-  }
+  });
   if (countValues) {
     std::size_t distinct = 0;
     for (std::size_t i = 0; i < valueCount.size(); ++i) {
@@ -113,45 +131,39 @@ double VolumeStats::quantile(double q) const {
   return max;
 }
 
-std::optional<std::array<double, 2>> valueRange(const io::AnyVolume& volume) {
-  return std::visit(
-      [](const auto& image) -> std::optional<std::array<double, 2>> {
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (auto v : image.data()) {
-          const double d = double(v);
-          if (std::isfinite(d)) {  // (NaN fails both comparisons below as well)
-            lo = std::min(lo, d);
-            hi = std::max(hi, d);
-          }
-        }
-        if (lo > hi) return std::nullopt;
-        return std::array<double, 2>{lo, hi};
-      },
-      volume);
+std::optional<std::array<double, 2>> valueRange(const VolumeView& volume) {
+  return visitView(volume, [&](auto type) -> std::optional<std::array<double, 2>> {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    forEachValue<decltype(type)>(volume, [&](auto v) {
+      const double d = double(v);
+      if (std::isfinite(d)) {  // (NaN fails both comparisons below as well)
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+      }
+    });
+    if (lo > hi) return std::nullopt;
+    return std::array<double, 2>{lo, hi};
+  });
 }
 
-VolumeStats computeStats(const io::AnyVolume& volume) {
-  return std::visit([](const auto& image) { return statsOf(image); }, volume);
+VolumeStats computeStats(const VolumeView& volume) {
+  return visitView(volume, [&](auto type) { return statsOf<decltype(type)>(volume); });
 }
 
-std::size_t countAbove(const io::AnyVolume& volume, double s) {
-  return std::visit(
-      [s](const auto& image) {
-        std::size_t n = 0;
-        for (auto v : image.data()) n += double(v) > s;
-        return n;
-      },
-      volume);
+std::size_t countAbove(const VolumeView& volume, double s) {
+  return visitView(volume, [&](auto type) {
+    std::size_t n = 0;
+    forEachValue<decltype(type)>(volume, [&](auto v) { n += double(v) > s; });
+    return n;
+  });
 }
 
-std::size_t countEqual(const io::AnyVolume& volume, double label) {
-  return std::visit(
-      [label](const auto& image) {
-        std::size_t n = 0;
-        for (auto v : image.data()) n += double(v) == label;
-        return n;
-      },
-      volume);
+std::size_t countEqual(const VolumeView& volume, double label) {
+  return visitView(volume, [&](auto type) {
+    std::size_t n = 0;
+    forEachValue<decltype(type)>(volume, [&](auto v) { n += double(v) == label; });
+    return n;
+  });
 }
 
 }  // namespace surftrack::cli

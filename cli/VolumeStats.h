@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "ReadVolume.h"
+#include "VolumeView.h"
 
 namespace surftrack::cli {
 
@@ -28,13 +28,13 @@ struct VolumeStats {
   double quantile(double q) const;
 };
 
-VolumeStats computeStats(const io::AnyVolume& volume);
+VolumeStats computeStats(const VolumeView& volume);
 
 /// The smallest and largest finite values (one pass), or nothing if no value is finite.
-std::optional<std::array<double, 2>> valueRange(const io::AnyVolume& volume);
+std::optional<std::array<double, 2>> valueRange(const VolumeView& volume);
 
 /// The number of voxels with f > s, and with f = label.
-std::size_t countAbove(const io::AnyVolume& volume, double s);
-std::size_t countEqual(const io::AnyVolume& volume, double label);
+std::size_t countAbove(const VolumeView& volume, double s);
+std::size_t countEqual(const VolumeView& volume, double label);
 
 }  // namespace surftrack::cli

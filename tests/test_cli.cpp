@@ -466,6 +466,37 @@ TEST_F(Cli, SummaryJsonAndQuiet) {
   EXPECT_NE(r.out.find("--seed-point"), std::string::npos);
 }
 
+// A seeded extraction from an uncompressed file maps it and reads the voxels near the surface
+// only; a compressed one is decoded. The bytes read are the engine's own count of the voxels it
+// asked for (Surface::voxelsRead), checked here against the size of the image.
+TEST_F(Cli, SeededExtractionFromAMappedFileReadsLittleOfIt) {
+  DenseImage<std::uint16_t> image(Dims{160, 150, 140}, 0);
+  addBall<std::uint16_t>(image, Voxel{80, 70, 60}, 9, 1000);
+  const std::size_t surfels = surfelsAbove(image, 500);
+  for (const std::string name : {"big.nii", "big.nrrd", "big.nii.gz"}) {
+    SCOPED_TRACE(name);
+    io::writeVolume(io::AnyVolume(image), path(name));
+    const RunResult r = run({"mesh", path(name), "-o", path(name + ".ply"), "--iso", "500", "--seed", "80,70,60", "--json"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(jsonNumber(r.out, "surfels"), double(surfels));
+    const double total = jsonNumber(r.out, "voxel_bytes"), read = jsonNumber(r.out, "voxel_bytes_read");
+    EXPECT_EQ(total, double(image.dims().count() * 2));
+    const bool compressed = name.size() > 3 && name.substr(name.size() - 3) == ".gz";
+    if (compressed) {
+      EXPECT_EQ(read, total);  // decoded whole
+      EXPECT_NE(r.out.find("\"mapped\": false"), std::string::npos) << r.out;
+    } else {
+      EXPECT_GT(read, double(surfels));        // every surfel's two voxels were read
+      EXPECT_LT(read, 0.05 * total) << r.out;  // and not much more
+      EXPECT_NE(r.out.find("\"mapped\": true"), std::string::npos) << r.out;
+      EXPECT_FALSE(std::isnan(jsonNumber(r.out, "voxel_bytes_resident")));
+    }
+  }
+  const RunResult info = run({"info", path("big.nrrd")});
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_NE(info.out.find("memory-mapped nrrd"), std::string::npos) << info.out;
+}
+
 TEST_F(Cli, DemoPhantom) {
   const std::string dir = path("demo");
   const RunResult r = run({"demo", "-o", dir, "--no-mricron", "--size", "48", "--json"});

@@ -284,6 +284,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
 
   stages.begin("place");
   out.vertices = placeVertices(source, mesh, out.mapping, o.selection, o.epsilon);
+  out.voxelsRead = binary.voxelsRead() + (out.mapping == Mapping::Linear ? 2 * mesh.surfels.size() : 0);
   for (auto& p : out.vertices) p = geometry.toPhysical(p);
   out.surfels = std::move(mesh.surfels);
   out.triangles = std::move(mesh.triangles);

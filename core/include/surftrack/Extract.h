@@ -136,6 +136,10 @@ struct Surface {
   Selection selection;
   Mapping mapping = Mapping::Midpoint;  ///< the mapping used (never Default)
   std::vector<StageTime> timings;
+  /// Voxels the extraction asked of the source: its bricks (apron included), rows and gray
+  /// values. What a lazy source (a memory-mapped file) has to read; a seeded extraction keeps
+  /// it proportional to the surface, a scan reads every voxel once or more.
+  std::uint64_t voxelsRead = 0;
 
   std::size_t vertexCount() const { return vertices.size(); }
   std::size_t triangleCount() const { return triangles.size(); }
