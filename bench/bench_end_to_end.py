@@ -34,7 +34,7 @@ VTK_SCRIPT = r'''
 import sys
 # Only the modules used (import vtk would load them all: seconds of start-up).
 from vtkmodules.vtkCommonCore import vtkSMPTools
-from vtkmodules.vtkFiltersCore import vtkCleanPolyData, vtkFlyingEdges3D, vtkPolyDataConnectivityFilter
+from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D, vtkPolyDataConnectivityFilter
 from vtkmodules.vtkIOImage import vtkImageReader2, vtkMetaImageReader
 from vtkmodules.vtkIOPLY import vtkPLYWriter
 path, iso, px, py, pz, threads, out = sys.argv[1:8]
@@ -57,14 +57,12 @@ conn = vtkPolyDataConnectivityFilter()
 conn.SetInputConnection(fe.GetOutputPort())
 conn.SetExtractionModeToClosestPointRegion()
 conn.SetClosestPoint(float(px), float(py), float(pz))
-clean = vtkCleanPolyData()  # drop the points of the other regions
-clean.SetInputConnection(conn.GetOutputPort())
-writer = vtkPLYWriter()
-writer.SetInputConnection(clean.GetOutputPort())
+writer = vtkPLYWriter()  # (the region's triangles, with every point of the input, as VTK does)
+writer.SetInputConnection(conn.GetOutputPort())
 writer.SetFileName(out)
 writer.SetFileTypeToBinary()
 writer.Write()
-print(clean.GetOutput().GetNumberOfPolys())
+print(conn.GetOutput().GetNumberOfPolys())
 '''
 
 SKIMAGE_SCRIPT = r'''

@@ -26,6 +26,9 @@ int runMesh(const std::vector<std::string>& args) {
   clock.lap(x.timings, "read");
   describeInput(volume, o.input.path, x);
 
+  // A seeded extraction reads bricks near one surface; Otsu's default and the scans read all.
+  const bool seeded = o.surface.seedMode != SeedMode::Largest && o.surface.seedMode != SeedMode::All;
+  if (seeded && (o.surface.iso || o.surface.label)) volume.advise(io::LoadedVolume::Access::Sparse);
   extractSurface(volume.view, o.surface, x, clock, progress, 1, stages);
   if (volume.mapped) x.voxelBytesResident = volume.residentBytes();
 

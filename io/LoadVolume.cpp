@@ -170,6 +170,10 @@ std::uintmax_t LoadedVolume::residentBytes() const {
   return mapped ? detail::residentBytes(view.data, dataBytes) : dataBytes;
 }
 
+void LoadedVolume::advise(Access access) const {
+  if (mapped) detail::adviseAccess(view.data, dataBytes, access == Access::Sparse);
+}
+
 LoadedVolume loadVolume(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read " + quoted(path) + ": no such file");

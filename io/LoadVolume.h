@@ -52,6 +52,15 @@ struct LoadedVolume {
   /// engine can read without waiting for the disk. dataBytes when decoded (the buffer is
   /// ordinary memory), 0 if mincore() fails.
   std::uintmax_t residentBytes() const;
+
+  /// How the engine is about to read a mapped volume. Sparse — a seeded extraction, which reads
+  /// 8^3 bricks near one surface — turns the kernel's read-around off (MADV_RANDOM), so that a
+  /// page fault reads its own page and not the 128 KiB or more around it: on a large volume
+  /// that is the difference between reading the surface's pages and reading a good part of
+  /// the file. Dense (the default of a mapping; scans, statistics) restores the read-around,
+  /// which suits rows read in order. No effect on a decoded volume or if madvise fails.
+  enum class Access { Dense, Sparse };
+  void advise(Access access) const;
 };
 
 /// Loads a volume, the format from the file name: .mha, .mhd, .nrrd, .nhdr and .nii are

@@ -136,6 +136,15 @@ std::shared_ptr<void> OpenFile::read(std::uint64_t offset, std::uint64_t bytes) 
   return buffer;
 }
 
+bool adviseAccess(const void* data, std::uint64_t bytes, bool sparse) {
+  if (!data || bytes == 0) return true;
+  const std::uint64_t page = pageSize();
+  const auto first = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t begin = first - first % page;
+  return ::madvise(reinterpret_cast<void*>(begin), std::size_t(first + bytes - begin),
+                   sparse ? MADV_RANDOM : MADV_NORMAL) == 0;
+}
+
 std::uint64_t residentBytes(const void* data, std::uint64_t bytes) {
   if (!data || bytes == 0) return 0;
   const std::uint64_t page = pageSize();

@@ -48,4 +48,8 @@ class OpenFile {
 /// 0 if mincore() fails.
 std::uint64_t residentBytes(const void* data, std::uint64_t bytes);
 
+/// madvise() on the pages of [data, data + bytes), inside one mapping: MADV_RANDOM if `sparse`
+/// (no read-around: a fault reads its own page), MADV_NORMAL otherwise. False if it fails.
+bool adviseAccess(const void* data, std::uint64_t bytes, bool sparse);
+
 }  // namespace surftrack::io::detail

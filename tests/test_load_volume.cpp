@@ -896,4 +896,45 @@ TEST(LoadVolume, AFreshlyMappedLargeFileIsNotReadUntilTouched) {
               double(before) / (1 << 20), double(after) / (1 << 20));
 }
 
+// With Access::Sparse (a seeded extraction) a page fault reads its own page only: touching one
+// byte every 256 KiB brings in about one page each, not the read-around of each fault.
+TEST(LoadVolume, SparseAccessReadsThePagesTouchedOnly) {
+  TempDir dir;
+  struct statfs fsInfo {};
+  ASSERT_EQ(::statfs(dir.path().c_str(), &fsInfo), 0);
+  if (fsInfo.f_type == 0x01021994)  // TMPFS_MAGIC
+    GTEST_SKIP() << dir.path() << " is a tmpfs: its pages are always resident";
+  const std::string path = dir / "sparse.raw";
+  const std::size_t bytes = std::size_t(64) << 20;
+  {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ASSERT_GE(fd, 0);
+    std::vector<unsigned char> chunk(std::size_t(1) << 20);
+    for (std::size_t i = 0; i < chunk.size(); ++i) chunk[i] = static_cast<unsigned char>(i * 13);
+    for (std::size_t at = 0; at < bytes; at += chunk.size())
+      ASSERT_EQ(::write(fd, chunk.data(), chunk.size()), ssize_t(chunk.size()));
+    ASSERT_EQ(::fdatasync(fd), 0);
+    ASSERT_EQ(::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED), 0);
+    ::close(fd);
+  }
+  io::RawLayout layout;
+  layout.dims = Dims{1024, 1024, 64};
+  const LoadedVolume v = io::loadRawVolume(path, layout);
+  ASSERT_TRUE(v.mapped) << v.decodeReason;
+  v.advise(LoadedVolume::Access::Sparse);
+  const std::uintmax_t before = v.residentBytes();
+  const auto* data = static_cast<const unsigned char*>(v.view.data);
+  unsigned sum = 0;
+  const std::size_t stride = std::size_t(256) << 10, touches = bytes / stride;
+  for (std::size_t i = 0; i < bytes; i += stride) sum += data[i];
+  const std::uintmax_t after = v.residentBytes();
+  EXPECT_EQ(data[stride + 5], static_cast<unsigned char>((stride + 5) * 13));
+  // One 4 KiB page per touch, give or take the pages resident before; read-around would bring
+  // in 32 or more per touch.
+  EXPECT_LE(after - before, touches * 4 * 4096) << "sum " << sum;
+  EXPECT_GE(after, touches * 4096 * 9 / 10);
+  std::printf("[          ] %zu touches: %.2f MiB resident (%.2f MiB before)\n", touches,
+              double(after) / (1 << 20), double(before) / (1 << 20));
+}
+
 }  // namespace
