@@ -72,7 +72,7 @@ Extraction extract(const io::AnyVolume& volume, const std::string& inputName, co
   const int stages = extractionStages(options) + 1;  // + write
   extractSurface(loaded.view, options, x, clock, progress, 0, stages);
   progress.stage(stages - 1, stages, "writing " + output);
-  x.bytes = writeMeshFile(x.mesh, output, x.binary);
+  x.bytes = writeMeshFile(x.surface, output, x.binary);
   clock.lap(x.timings, "write");
   x.totalSeconds = clock.total() + readSeconds;
   progress.finish();

@@ -196,15 +196,17 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   x.voxelBytesRead = x.mapped ? std::min<std::uintmax_t>(surface.voxelsRead * sizeOf(volume.type), x.voxelBytes)
                              : x.voxelBytes;
 
-  progress.stage(stage + extractionStages(o) - 1, stageCount, "building the mesh");
-  TriangleMesh triangles{std::move(surface.surfels), std::move(surface.triangles)};
+  // The files need no half-edge operation: the triangles are checked to be a closed oriented
+  // 2-manifold (what building the OpenMesh mesh would check) and written from the list.
+  progress.stage(stage + extractionStages(o) - 1, stageCount, "checking the mesh");
   try {
-    x.mesh = toSurfaceMesh(triangles, surface.vertices);  // checks the closed oriented manifold
+    requireClosedOrientedManifold(surface.vertices.size(), surface.triangles);
   } catch (const std::logic_error& e) {
     throw InternalError(e.what());
   }
-  x.stats = meshStats(surface, x.mesh);
-  clock.lap(x.timings, "mesh");
+  x.stats = meshStats(surface);
+  x.surface = std::move(surface);
+  clock.lap(x.timings, "check");
 }
 
 }  // namespace surftrack::cli

@@ -15,6 +15,7 @@
 #include "Progress.h"
 #include "LoadVolume.h"
 #include "ReadVolume.h"
+#include "Extract.h"
 #include "SurfaceMesh.h"
 #include "VolumeView.h"
 
@@ -88,7 +89,7 @@ struct Extraction {
   // The result.
   std::vector<std::string> warnings;  ///< printed on stderr (e.g. a speck)
   std::size_t surfels = 0;
-  SurfaceMesh mesh;
+  Surface surface;  ///< the mesh written: vertices, oriented triangles, surfels
   MeshStats stats;
   std::vector<StageTiming> timings;
   double totalSeconds = 0;

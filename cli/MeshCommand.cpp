@@ -33,7 +33,7 @@ int runMesh(const std::vector<std::string>& args) {
   if (volume.mapped) x.voxelBytesResident = volume.residentBytes();
 
   progress.stage(stages - 1, stages, "writing " + o.output);
-  x.bytes = writeMeshFile(x.mesh, o.output, x.binary);
+  x.bytes = writeMeshFile(x.surface, o.output, x.binary);
   clock.lap(x.timings, "write");
   x.totalSeconds = clock.total();
   progress.finish();

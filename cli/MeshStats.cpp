@@ -5,14 +5,14 @@
 
 namespace surftrack::cli {
 
-MeshStats meshStats(const Surface& surface, const SurfaceMesh& mesh) {
+MeshStats meshStats(const Surface& surface) {
   MeshStats s;
-  s.vertices = mesh.n_vertices();
-  s.edges = mesh.n_edges();
-  s.triangles = mesh.n_faces();
+  s.vertices = surface.vertices.size();
+  s.triangles = surface.triangles.size();
+  s.edges = 3 * s.triangles / 2;
   s.euler = (long long)s.vertices - (long long)s.edges + (long long)s.triangles;
   s.components = surface.components;
-  s.closed = s.manifold = true;  // toSurfaceMesh's checks (SurfaceMesh.h)
+  s.closed = s.manifold = true;  // requireClosedOrientedManifold's checks (SurfaceMesh.h)
 
   const double inf = std::numeric_limits<double>::infinity();
   s.min = {inf, inf, inf};

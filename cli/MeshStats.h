@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "Extract.h"
-#include "SurfaceMesh.h"
 
 namespace surftrack::cli {
 
@@ -22,9 +21,9 @@ struct MeshStats {
   std::array<double, 3> min{}, max{};  ///< bounding box of the vertices (physical)
 };
 
-/// The figures of `surface`, whose half-edge mesh `mesh` is: toSurfaceMesh built it, which
-/// refuses anything but a closed, consistently oriented 2-manifold, so both flags are true
-/// here; the counts come from the mesh, the components from the engine (surface.components).
-MeshStats meshStats(const Surface& surface, const SurfaceMesh& mesh);
+/// The figures of `surface`, whose triangles requireClosedOrientedManifold (SurfaceMesh.h) has
+/// accepted: a closed, consistently oriented 2-manifold, so both flags are true and every edge
+/// is in two triangles (E = 3F / 2); the components' figures are the engine's.
+MeshStats meshStats(const Surface& surface);
 
 }  // namespace surftrack::cli

@@ -38,9 +38,9 @@ void requireWritable(const std::string& path) {
     throw std::runtime_error("cannot write '" + path + "': permission denied");
 }
 
-std::uintmax_t writeMeshFile(const SurfaceMesh& mesh, const std::string& path, bool binary) {
+std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bool binary) {
   try {
-    writeMesh(mesh, path, binary);
+    writeTriangles(surface.vertices, surface.triangles, path, binary);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(e.what());
   }

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "SurfaceMesh.h"
+#include "Extract.h"
 
 namespace surftrack::cli {
 
@@ -16,7 +16,8 @@ std::string meshFormat(const std::string& path);
 /// is missing or not writable, or `path` is a directory.
 void requireWritable(const std::string& path);
 
-/// Writes the mesh (binary PLY / STL unless `binary` is false); returns the file size.
-std::uintmax_t writeMeshFile(const SurfaceMesh& mesh, const std::string& path, bool binary);
+/// Writes the surface's triangles (binary PLY / STL unless `binary` is false) with OpenMesh's
+/// writers (converter/MeshIO.h writeTriangles); returns the file size.
+std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bool binary);
 
 }  // namespace surftrack::cli

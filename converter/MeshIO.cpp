@@ -8,7 +8,9 @@
 #include <stdexcept>
 #include <system_error>
 
+#include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/IO/exporter/BaseExporter.hh>
 
 namespace surftrack {
 namespace {
@@ -30,7 +32,124 @@ fs::path temporaryPathFor(const fs::path& path, const std::string& ext) {
   return path.parent_path() / ("." + name);
 }
 
+/// A triangle list seen as OpenMesh's writers see a mesh: what ExporterT gives for a
+/// SurfaceMesh without normals, colours, texture coordinates or status (double points).
+class TriangleListExporter final : public OpenMesh::IO::BaseExporter {
+ public:
+  using VH = OpenMesh::VertexHandle;
+  using FH = OpenMesh::FaceHandle;
+  using EH = OpenMesh::EdgeHandle;
+  using HH = OpenMesh::HalfedgeHandle;
+  using Status = OpenMesh::Attributes::StatusInfo;
+
+  TriangleListExporter(const std::vector<std::array<double, 3>>& v,
+                       const std::vector<std::array<std::uint32_t, 3>>& t)
+      : v_(v), t_(t) {}
+
+  OpenMesh::Vec3f point(VH h) const override {
+    const auto& p = v_[std::size_t(h.idx())];
+    return {float(p[0]), float(p[1]), float(p[2])};
+  }
+  OpenMesh::Vec3d pointd(VH h) const override {
+    const auto& p = v_[std::size_t(h.idx())];
+    return {p[0], p[1], p[2]};
+  }
+  bool is_point_double() const override { return true; }
+  bool is_normal_double() const override { return false; }
+  OpenMesh::Vec3f normal(VH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec3d normald(VH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec3uc color(VH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4uc colorA(VH) const override { return {0, 0, 0, 0}; }
+  OpenMesh::Vec3ui colori(VH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4ui colorAi(VH) const override { return {0, 0, 0, 0}; }
+  OpenMesh::Vec3f colorf(VH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4f colorAf(VH) const override { return {0, 0, 0, 0}; }
+  OpenMesh::Vec2f texcoord(VH) const override { return {0, 0}; }
+  OpenMesh::Vec2f texcoord(HH) const override { return {0, 0}; }
+  Status status(VH) const override { return {}; }
+
+  unsigned int get_vhandles(FH f, std::vector<VH>& out) const override {
+    const auto& t = t_[std::size_t(f.idx())];
+    out.assign({VH(int(t[0])), VH(int(t[1])), VH(int(t[2]))});
+    return 3;
+  }
+  HH getHeh(FH, VH) const override { return HH(); }
+  unsigned int get_face_texcoords(std::vector<OpenMesh::Vec2f>& out) const override {
+    out.clear();
+    return 0;
+  }
+  OpenMesh::Vec3f normal(FH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec3d normald(FH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec3uc color(FH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4uc colorA(FH) const override { return {0, 0, 0, 0}; }
+  OpenMesh::Vec3ui colori(FH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4ui colorAi(FH) const override { return {0, 0, 0, 0}; }
+  OpenMesh::Vec3f colorf(FH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4f colorAf(FH) const override { return {0, 0, 0, 0}; }
+  Status status(FH) const override { return {}; }
+
+  OpenMesh::Vec3uc color(EH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4uc colorA(EH) const override { return {0, 0, 0, 0}; }
+  OpenMesh::Vec3ui colori(EH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4ui colorAi(EH) const override { return {0, 0, 0, 0}; }
+  OpenMesh::Vec3f colorf(EH) const override { return {0, 0, 0}; }
+  OpenMesh::Vec4f colorAf(EH) const override { return {0, 0, 0, 0}; }
+  Status status(EH) const override { return {}; }
+
+  // Halfedge queries serve the OM format's writer only, which writeTriangles does not offer.
+  int get_halfedge_id(VH) override { return -1; }
+  int get_halfedge_id(FH) override { return -1; }
+  int get_next_halfedge_id(HH) override { return -1; }
+  int get_to_vertex_id(HH) override { return -1; }
+  int get_face_id(HH) override { return -1; }
+  Status status(HH) const override { return {}; }
+
+  std::size_t n_vertices() const override { return v_.size(); }
+  std::size_t n_faces() const override { return t_.size(); }
+  std::size_t n_edges() const override { return 3 * t_.size() / 2; }  // closed: each edge twice
+  bool is_triangle_mesh() const override { return true; }
+  // The PLY writer looks for custom properties in the kernel: an empty one has none.
+  const OpenMesh::BaseKernel* kernel() override { return &noProperties_; }
+
+ private:
+  OpenMesh::BaseKernel noProperties_;
+  const std::vector<std::array<double, 3>>& v_;
+  const std::vector<std::array<std::uint32_t, 3>>& t_;
+};
+
+/// The extension of `path` if it is one writeMesh knows, else std::invalid_argument.
+std::string meshExtension(const std::string& path) {
+  constexpr std::array<const char*, 4> kFormats = {".ply", ".obj", ".off", ".stl"};
+  const std::string ext = lowerExtension(fs::path(path));
+  if (std::find(kFormats.begin(), kFormats.end(), ext) == kFormats.end())
+    throw std::invalid_argument("cannot write mesh '" + path + "': unknown extension '" + ext +
+                                "' (expected .ply, .obj, .off or .stl)");
+  return ext;
+}
+
 }  // namespace
+
+void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
+                    const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path,
+                    bool binary) {
+  const std::string ext = meshExtension(path);
+  OpenMesh::IO::Options options = OpenMesh::IO::Options::Default;
+  if (binary && (ext == ".ply" || ext == ".stl")) options += OpenMesh::IO::Options::Binary;
+  TriangleListExporter exporter(vertices, triangles);
+  const fs::path target(path);
+  const fs::path temporary = temporaryPathFor(target, ext);
+  std::error_code ignored;
+  if (!OpenMesh::IO::IOManager().write(temporary.string(), exporter, options, 12)) {
+    fs::remove(temporary, ignored);
+    throw std::runtime_error("cannot write mesh to '" + path + "'");
+  }
+  std::error_code error;
+  fs::rename(temporary, target, error);
+  if (error) {
+    fs::remove(temporary, ignored);
+    throw std::runtime_error("cannot write mesh to '" + path + "': " + error.message());
+  }
+}
 
 void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary) {
   constexpr std::array<const char*, 4> kFormats = {".ply", ".obj", ".off", ".stl"};

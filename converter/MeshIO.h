@@ -1,7 +1,10 @@
 // Writing a SurfaceMesh with OpenMesh's IO, the format chosen by the file extension.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "SurfaceMesh.h"
 
@@ -14,5 +17,13 @@ namespace surftrack {
 /// Throws std::invalid_argument for an unknown extension, std::runtime_error naming the path
 /// when it cannot be written.
 void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary = true);
+
+/// The same file from a triangle list, with no half-edge mesh: OpenMesh's writers read the
+/// vertices and triangles through an exporter (OpenMesh::IO::BaseExporter), so the bytes are
+/// those writeMesh writes for toSurfaceMesh of the same triangles. For files that need no
+/// half-edge operation. \throw as writeMesh.
+void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
+                    const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path,
+                    bool binary = true);
 
 }  // namespace surftrack

@@ -231,22 +231,17 @@ bool shortFan(const std::uint32_t* c, const std::uint32_t* vertexAt, std::uint32
   return self == 0 && i == 0 && returns == 1;
 }
 
-}  // namespace
-
-SurfaceMesh toSurfaceMesh(const TriangleMesh& mesh,
-                          const std::vector<std::array<double, 3>>& positions) {
-  const auto& T = mesh.triangles;
-  const std::size_t V = mesh.surfels.size(), F = T.size(), H = 3 * F;
-  if (positions.size() != V)
-    throw std::invalid_argument("toSurfaceMesh: " + std::to_string(positions.size()) +
-                                " positions for " + std::to_string(V) + " vertices");
-  // OpenMesh handles are ints; a corner f << 2 | j and a halfedge index with a flag bit below
-  // also fit in 32 bits.
-  if (H > std::size_t(std::numeric_limits<int>::max()) ||
-      V > std::size_t(std::numeric_limits<int>::max()))
-    throw std::invalid_argument("toSurfaceMesh: " + std::to_string(F) + " triangles and " +
-                                std::to_string(V) + " vertices exceed OpenMesh's handle range");
-
+/// Steps 1 and 2 of the direct construction: the corners sorted by vertex, then each vertex's
+/// fan checked to be one cycle, which pairs every directed edge h of the triangles (3f + j, from
+/// corner j of triangle f) with its opposite link[h]. link has 3F + 1 entries (the last a dead
+/// end). Checking every vertex's fan is what makes the triangles a closed, consistently oriented
+/// 2-manifold: each directed edge is then used once and its opposite once, and each vertex's
+/// triangles form one disc. \pre the sizes fit OpenMesh's int handles.
+/// \throw std::invalid_argument for a vertex index out of range, std::logic_error (naming the
+///        vertex and the reason) when the triangles are not a closed oriented manifold.
+FreshArray<std::uint32_t> pairDirectedEdges(const std::vector<std::array<std::uint32_t, 3>>& T,
+                                            std::size_t V) {
+  const std::size_t F = T.size(), H = 3 * F;
   // 1. Counting sort of the corners by vertex (CSR): count (noting each corner's rank among
   //    its vertex's), prefix sum, fill; the corners of u are then corners[start[u] ..
   //    start[u+1]). The ranks, kept in link[] until step 2 needs the array, spare the fill a
@@ -254,7 +249,7 @@ SurfaceMesh toSurfaceMesh(const TriangleMesh& mesh,
   //    would chain.
   const FreshArray<std::uint32_t> start = freshArray<std::uint32_t>(V + 1);
   std::fill(start.get(), start.get() + V + 1, 0u);
-  const FreshArray<std::uint32_t> link = freshArray<std::uint32_t>(H + 1);  // + a dead end
+  FreshArray<std::uint32_t> link = freshArray<std::uint32_t>(H + 1);  // + a dead end
   for (std::size_t f = 0; f < F; ++f) {
     const auto& t = T[f];
     if (std::max({t[0], t[1], t[2]}) >= V)
@@ -379,6 +374,39 @@ SurfaceMesh toSurfaceMesh(const TriangleMesh& mesh,
       if (i != 0 || steps != d) slowFanCheck(T, std::uint32_t(u), c, d);
     }
   }
+
+  return link;
+}
+
+/// OpenMesh handles are ints; a corner f << 2 | j and a halfedge index with a flag bit below
+/// also fit in 32 bits.
+void requireHandleRange(std::size_t F, std::size_t V) {
+  const std::size_t H = 3 * F;
+  if (H > std::size_t(std::numeric_limits<int>::max()) ||
+      V > std::size_t(std::numeric_limits<int>::max()))
+    throw std::invalid_argument("toSurfaceMesh: " + std::to_string(F) +
+                                " triangles and " + std::to_string(V) +
+                                " vertices exceed OpenMesh's handle range");
+}
+
+}  // namespace
+
+void requireClosedOrientedManifold(std::size_t vertexCount,
+                                   const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  requireHandleRange(triangles.size(), vertexCount);
+  pairDirectedEdges(triangles, vertexCount);
+}
+
+
+SurfaceMesh toSurfaceMesh(const TriangleMesh& mesh,
+                          const std::vector<std::array<double, 3>>& positions) {
+  const auto& T = mesh.triangles;
+  const std::size_t V = mesh.surfels.size(), F = T.size(), H = 3 * F;
+  if (positions.size() != V)
+    throw std::invalid_argument("toSurfaceMesh: " + std::to_string(positions.size()) +
+                                " positions for " + std::to_string(V) + " vertices");
+  requireHandleRange(F, V);
+  const FreshArray<std::uint32_t> link = pairDirectedEdges(T, V);
 
   // 3. Edges are numbered as add_face numbers them: edge e is the e-th met in face order, its
   //    halfedge 2e runs as in that first face and 2e + 1 opposite (as new_edge(from, to) makes

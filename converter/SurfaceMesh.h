@@ -65,6 +65,12 @@ std::vector<std::array<double, 3>> mapVertices(const TriangleMesh& mesh, const M
 SurfaceMesh toSurfaceMesh(const TriangleMesh& mesh,
                           const std::vector<std::array<double, 3>>& positions);
 
+/// The checks of toSurfaceMesh without building anything: returns iff the triangles are a
+/// closed, consistently oriented 2-manifold in which each of the vertices 0 .. vertexCount - 1
+/// lies. \throw std::invalid_argument, std::logic_error as toSurfaceMesh.
+void requireClosedOrientedManifold(std::size_t vertexCount,
+                                   const std::vector<std::array<std::uint32_t, 3>>& triangles);
+
 /// The reference construction: the same mesh built face by face with OpenMesh's add_face, whose
 /// own topology checks refuse a complex edge or vertex. Several times slower than toSurfaceMesh
 /// (docs/performance.md); kept as an independent check of it. Throws std::invalid_argument like

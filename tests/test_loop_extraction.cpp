@@ -8,6 +8,8 @@
 #include <bit>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <numbers>
 #include <random>
@@ -514,6 +516,41 @@ TEST_F(MeshFiles, RoundTripThroughOpenMesh) {
     }
   }
   EXPECT_EQ(filesInDir(), cases.size()) << "no temporary file may remain";
+}
+
+std::string fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// writeTriangles (an exporter over the triangle list) writes the bytes writeMesh writes for the
+// half-edge mesh of the same triangles, in every format, on the boundaries of random images.
+TEST_F(MeshFiles, TriangleListFilesEqualHalfedgeMeshFiles) {
+  for (int i = 0; i < 8; ++i) {
+    const auto volume = ref::randomVolume({7 + i, 6 + i, 5 + i}, 0.3 + 0.05 * i, 6100u + i);
+    const auto image = binaryView(volume);
+    const AdjacencyPair pair = kAllAdjacencyPairs[i % 4];
+    const auto boundaries = scanBoundaries(image, pair).components();
+    ASSERT_FALSE(boundaries.empty());
+    const TriangleMesh mesh = extractLoops(image, trackComponent(image, boundaries.front().front(), pair));
+    std::vector<Point> positions = mapVertices(mesh, MidpointMapping{});
+    for (auto& p : positions) p = {p[0] * 0.7 + 0.1, p[1] * 1.3, p[2] - 5};  // digits beyond halves
+    const SurfaceMesh om = toSurfaceMesh(mesh, positions);
+    for (const std::string name : {"a.ply", "b.ply", "c.obj", "d.off", "e.stl", "f.stl"}) {
+      SCOPED_TRACE("image " + std::to_string(i) + " " + name);
+      const bool binary = name != "b.ply" && name != "f.stl";
+      const std::string viaMesh = (dir_ / ("m" + name)).string(), viaList = (dir_ / ("t" + name)).string();
+      writeMesh(om, viaMesh, binary);
+      writeTriangles(positions, mesh.triangles, viaList, binary);
+      const std::string a = fileBytes(viaMesh), b = fileBytes(viaList);
+      EXPECT_GT(a.size(), 100u);
+      EXPECT_TRUE(a == b) << a.size() << " vs " << b.size() << " bytes";
+    }
+  }
+  EXPECT_EQ(filesInDir(), 12u) << "no temporary file may remain";
+  EXPECT_THROW(writeTriangles({}, {}, (dir_ / "mesh.xyz").string()), std::invalid_argument);
+  EXPECT_THROW(writeTriangles({}, {}, (dir_ / "no" / "dir" / "mesh.ply").string()), std::runtime_error);
+  EXPECT_EQ(filesInDir(), 12u);
 }
 
 TEST_F(MeshFiles, UnknownExtensionAndUnwritablePathThrowAndLeaveNoFile) {

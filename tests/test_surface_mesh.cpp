@@ -132,6 +132,7 @@ std::vector<int> faceVertices(const SurfaceMesh& m, SurfaceMesh::FaceHandle f) {
 /// Both constructions on one indexed mesh, compared.
 void checkBoth(const TriangleMesh& mesh, const std::vector<Point>& positions) {
   SurfaceMesh direct, byAddFace;
+  ASSERT_NO_THROW(requireClosedOrientedManifold(mesh.surfels.size(), mesh.triangles));
   ASSERT_NO_THROW(direct = toSurfaceMesh(mesh, positions));
   ASSERT_NO_THROW(byAddFace = toSurfaceMeshByAddFace(mesh, positions));
   EXPECT_TRUE(isClosedHalfedgeMesh(direct, mesh));
@@ -227,8 +228,14 @@ std::vector<Triangle> operator+(std::vector<Triangle> x, const std::vector<Trian
   return x;
 }
 
-/// toSurfaceMesh throws std::logic_error saying the triangles are not a manifold.
+/// toSurfaceMesh (and requireClosedOrientedManifold) throw std::logic_error saying the
+/// triangles are not a manifold.
 ::testing::AssertionResult rejected(const TriangleMesh& m) {
+  try {
+    requireClosedOrientedManifold(m.surfels.size(), m.triangles);
+    return ::testing::AssertionFailure() << "accepted by requireClosedOrientedManifold";
+  } catch (const std::logic_error&) {
+  }
   try {
     toSurfaceMesh(m, positionsOf(m));
   } catch (const std::logic_error& e) {
