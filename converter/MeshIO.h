@@ -19,7 +19,8 @@ namespace surftrack {
 void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary = true);
 
 /// The same file from a triangle list, with no half-edge mesh: OpenMesh's writers read the
-/// vertices and triangles through an exporter (OpenMesh::IO::BaseExporter), so the bytes are
+/// vertices and triangles through an exporter (OpenMesh::IO::BaseExporter) — binary PLY is
+/// written from whole arrays instead, byte for byte as OpenMesh writes it — so the bytes are
 /// those writeMesh writes for toSurfaceMesh of the same triangles. For files that need no
 /// half-edge operation. \throw as writeMesh.
 void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
