@@ -12,6 +12,7 @@
 #include "FindSeed.h"
 #include "LoopExtraction.h"
 #include "ScanIsoSurface.h"
+#include "PlaceSurface.h"
 #include "SelectionValue.h"
 #include "SourceImage.h"
 #include "TrackComponent.h"
@@ -142,9 +143,11 @@ Surfel resolveSurfelSeed(const SourceImage& binary, const Surfel& s) {
   return s;
 }
 
+}  // namespace
+
 /// Vertex positions in index space by the boundary mapping (paper §3.1); the linear one reads
 /// the gray values of both voxels of each surfel, in one batch, from the source.
-std::vector<std::array<double, 3>> placeVertices(const VoxelSource& source, const TriangleMesh& mesh,
+static std::vector<std::array<double, 3>> placeVertices(const VoxelSource& source, const TriangleMesh& mesh,
                                                  Mapping mapping, const Selection& selection,
                                                  double epsilon) {
   const std::size_t n = mesh.surfels.size();
@@ -178,7 +181,22 @@ std::vector<std::array<double, 3>> placeVertices(const VoxelSource& source, cons
   return points;
 }
 
-}  // namespace
+void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mapping,
+                  const Selection& selection, double epsilon, Surface& out) {
+  const ImageGeometry geometry = source.geometry();
+  out.vertices = placeVertices(source, mesh, mapping, selection, epsilon);
+  for (auto& p : out.vertices) p = geometry.toPhysical(p);
+  out.surfels = std::move(mesh.surfels);
+  out.triangles = std::move(mesh.triangles);
+  if (geometry.handedness() < 0)  // a mirrored frame: keep the normals pointing outwards
+    for (auto& t : out.triangles) std::swap(t[1], t[2]);
+}
+
+void addFigures(Surface& out) {
+  out.components = componentFigures(out.vertices, out.triangles);
+  out.euler = 0;
+  for (const ComponentFigures& c : out.components) out.euler += c.euler;
+}
 
 Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   using Kind = SeedRule::Kind;
@@ -283,17 +301,11 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   }
 
   stages.begin("place");
-  out.vertices = placeVertices(source, mesh, out.mapping, o.selection, o.epsilon);
-  for (auto& p : out.vertices) p = geometry.toPhysical(p);
-  out.surfels = std::move(mesh.surfels);
-  out.triangles = std::move(mesh.triangles);
-  if (geometry.handedness() < 0)  // a mirrored frame: keep the normals pointing outwards
-    for (auto& t : out.triangles) std::swap(t[1], t[2]);
+  placeSurface(source, std::move(mesh), out.mapping, o.selection, o.epsilon, out);
 
   stages.begin("figures");
-  if (o.figures) out.components = componentFigures(out.vertices, out.triangles);
+  if (o.figures) addFigures(out);
   if (scanning) out.boundariesInImage = out.components.size();
-  for (const ComponentFigures& c : out.components) out.euler += c.euler;
   stages.end();
   // A seeded surface of a handful of voxels in a large image is most likely noise reached by
   // the seed rule, not the object the caller meant.
