@@ -32,6 +32,29 @@ fs::path temporaryPathFor(const fs::path& path, const std::string& ext) {
 
 }  // namespace
 
+void writeFileAtomically(const std::string& path, const std::function<bool(const std::string&)>& write) {
+  const fs::path target(path);
+  const fs::path temporary = temporaryPathFor(target, lowerExtension(target));
+  std::error_code ignored;
+  bool written = false;
+  try {
+    written = write(temporary.string());
+  } catch (...) {
+    fs::remove(temporary, ignored);
+    throw;
+  }
+  if (!written) {
+    fs::remove(temporary, ignored);
+    throw std::runtime_error("cannot write '" + path + "'");
+  }
+  std::error_code error;
+  fs::rename(temporary, target, error);
+  if (error) {
+    fs::remove(temporary, ignored);
+    throw std::runtime_error("cannot write '" + path + "': " + error.message());
+  }
+}
+
 void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary) {
   constexpr std::array<const char*, 4> kFormats = {".ply", ".obj", ".off", ".stl"};
   const fs::path target(path);
@@ -43,18 +66,9 @@ void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary) {
   OpenMesh::IO::Options options = OpenMesh::IO::Options::Default;
   if (binary && (ext == ".ply" || ext == ".stl")) options += OpenMesh::IO::Options::Binary;
 
-  const fs::path temporary = temporaryPathFor(target, ext);
-  std::error_code ignored;
-  if (!OpenMesh::IO::write_mesh(mesh, temporary.string(), options, 12)) {
-    fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write mesh to '" + path + "'");
-  }
-  std::error_code error;
-  fs::rename(temporary, target, error);
-  if (error) {
-    fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write mesh to '" + path + "': " + error.message());
-  }
+  writeFileAtomically(path, [&](const std::string& temporary) {
+    return OpenMesh::IO::write_mesh(mesh, temporary, options, 12);
+  });
 }
 
 }  // namespace surftrack

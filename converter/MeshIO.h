@@ -1,6 +1,7 @@
 // Writing a SurfaceMesh with OpenMesh's IO, the format chosen by the file extension.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "SurfaceMesh.h"
@@ -14,5 +15,11 @@ namespace surftrack {
 /// Throws std::invalid_argument for an unknown extension, std::runtime_error naming the path
 /// when it cannot be written.
 void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary = true);
+
+/// Calls write(temporary) with a fresh file name next to `path` (same directory and extension),
+/// then renames that file over `path`: a reader sees the old file or the whole new one, never a
+/// partial one. If `write` throws or returns false the temporary file is removed and
+/// std::runtime_error names `path`.
+void writeFileAtomically(const std::string& path, const std::function<bool(const std::string& temporary)>& write);
 
 }  // namespace surftrack

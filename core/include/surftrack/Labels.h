@@ -14,6 +14,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "AdjacencyPair.h"
@@ -84,5 +85,11 @@ struct LabelSurface {
 /// \throw Cancelled when options.cancel is raised.
 /// \throw InternalError when an engine invariant fails (a bug).
 std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options);
+
+/// Writes every surface into one PLY file (binary little-endian, or text): the vertices of each
+/// label in turn (a vertex on an interface once per label it bounds), with an int property
+/// `label` on every vertex and every face. Through a temporary file renamed over `path`.
+/// \throw std::runtime_error naming the path when it cannot be written.
+void writeLabelSurfaces(const std::vector<LabelSurface>& surfaces, const std::string& path, bool binary = true);
 
 }  // namespace surftrack
