@@ -172,8 +172,10 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
       if (!(std::abs(double(L)) <= std::ldexp(1.0, 53)))
         throw InvalidInput("label " + std::to_string(L) + " is beyond 2^53: labels must be exact as doubles");
 
-  const std::vector<std::size_t> selected = selectLabels(seeds, o.labels, o.background);
+  std::vector<std::size_t> selected = selectLabels(seeds, o.labels, o.background);
   const std::vector<std::vector<std::size_t>> wanted = wantedSeeds(image, seeds, selected, o);
+  if (o.boundaries == LabelBoundaries::FromSeeds)  // only the labels of the seeds
+    std::erase_if(selected, [&](std::size_t i) { return wanted[i].empty(); });
 
   // 2. The labels, largest first so that the last to finish are small.
   std::vector<std::size_t> order(selected.size());

@@ -44,7 +44,7 @@ struct LabelSelection {
 enum class LabelBoundaries {
   All,       ///< every boundary of the label
   Largest,   ///< the boundary with the most surfels (ties: the first met by the scan)
-  FromSeeds  ///< the boundaries reached from LabelOptions::seeds
+  FromSeeds  ///< the boundaries reached from LabelOptions::seeds (only the seeds' labels)
 };
 
 struct LabelOptions {
