@@ -10,10 +10,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "LabelsCommand.h"
+
 #include "Commands.h"
-#include "Extraction.h"
 #include "LabelNames.h"
-#include "LabelTable.h"
 #include "Labels.h"
 #include "MeshIO.h"
 #include "OutputFile.h"
@@ -66,8 +66,7 @@ std::string tableText(const std::string& path, const std::vector<LabelRow>& rows
 
 }  // namespace
 
-int runLabels(const std::vector<std::string>& args) {
-  const LabelsOptions o = parseLabelsOptions(args);
+LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   // Everything that can be checked before the work is.
   const OutputKind kind = outputKind(o.output);
   if (kind == OutputKind::Pattern) meshFormat(o.output);
@@ -89,7 +88,9 @@ int runLabels(const std::vector<std::string>& args) {
   StagedOutputs staged = kind == OutputKind::Directory ? StagedOutputs::inDirectory(o.output) : StagedOutputs();
 
   StageClock clock;
-  std::vector<StageTiming> timings;
+  LabelsRun run;
+  run.namesFile = namesFile;
+  std::vector<StageTiming>& timings = run.timings;
   const io::AnyVolume volume = readInput(o.input);
   clock.lap(timings, "read");
   const VolumeView view = std::visit(
@@ -111,7 +112,7 @@ int runLabels(const std::vector<std::string>& args) {
 
   // The rows, and the file of each label.
   const double voxelVolume = std::abs(view.geometry.handedness());
-  std::vector<LabelRow> rows;
+  std::vector<LabelRow>& rows = run.rows;
   std::set<std::string> files;
   for (const LabelSurface& ls : surfaces) {
     LabelRow r;
@@ -152,7 +153,14 @@ int runLabels(const std::vector<std::string>& args) {
   }
   if (!o.table.empty()) writeText(o.table, tableText(o.table, rows));
   clock.lap(timings, "write");
+  return run;
+}
 
+int runLabels(const std::vector<std::string>& args) {
+  const LabelsOptions o = parseLabelsOptions(args);
+  const LabelsRun run = writeLabelMeshes(o);
+  const std::vector<LabelRow>& rows = run.rows;
+  const std::string& namesFile = run.namesFile;
   if (o.out.json) {
     nlohmann::ordered_json j;
     j["input"] = o.input.path;
@@ -161,7 +169,7 @@ int runLabels(const std::vector<std::string>& args) {
     j["adjacency"] = toString(o.pair);
     j["labels"] = labelTableJson(rows);
     nlohmann::ordered_json t = nlohmann::ordered_json::object();
-    for (const StageTiming& s : timings) t[s.name] = number(s.seconds);
+    for (const StageTiming& s : run.timings) t[s.name] = number(s.seconds);
     j["seconds"] = t;
     std::cout << jsonText(j) << std::endl;
   } else if (!o.out.quiet) {
@@ -170,7 +178,7 @@ int runLabels(const std::vector<std::string>& args) {
     std::cout << "surftrack labels: " << rows.size() << " label" << (rows.size() == 1 ? "" : "s") << ", "
               << boundaries << " boundaries, " << surfels << " surfels -> " << o.output << "\n";
     if (!namesFile.empty()) std::cout << "  names      " << namesFile << "\n";
-    for (const StageTiming& s : timings) std::cout << "  " << s.name << std::string(11 - s.name.size(), ' ') << num(s.seconds, 3) << " s\n";
+    for (const StageTiming& s : run.timings) std::cout << "  " << s.name << std::string(11 - s.name.size(), ' ') << num(s.seconds, 3) << " s\n";
   }
   return 0;
 }

@@ -696,6 +696,16 @@ TEST_F(Cli, MricronDemoSurfacesAreClosedManifolds) {
     EXPECT_EQ(jsonNumber(json, "components"), 1.0);
   }
   EXPECT_EQ(r.out.find("mricron-data is not installed"), std::string::npos);
+  // The whole atlas, one closed mesh per region, named from aal.nii.txt.
+  const std::vector<std::string> regions = listDirectory(dir + "/aal-regions");
+  EXPECT_EQ(regions.size(), 117u);  // 116 regions and labels.csv
+  EXPECT_EQ(jsonNumber(r.out, "regions"), 116.0);
+  EXPECT_TRUE(fs::exists(dir + "/aal-regions/1_Precentral_L.ply"));
+  EXPECT_TRUE(fs::exists(dir + "/aal-regions/116_Vermis_10.ply"));
+  for (const std::string& file : {"1_Precentral_L.ply", "116_Vermis_10.ply"}) {
+    const MeshCheck c = checkMeshFile(dir + "/aal-regions/" + file);
+    EXPECT_TRUE(c.read && c.closed && c.manifold) << file;
+  }
 }
 
 TEST_F(Cli, MricronLabelSurfelsEqualTheDirectCount) {

@@ -166,7 +166,7 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
     const int z1 = int(std::int64_t(dims.nz) * std::int64_t(k + 1) / std::int64_t(slabs.size()));
     slabs[k] = scanLabelSeeds(image, T(o.background), z0, z1);
   });
-  const LabelSeeds<T> seeds = mergeLabelSeeds(std::move(slabs));
+  LabelSeeds<T> seeds = mergeLabelSeeds(std::move(slabs));
   if constexpr (sizeof(T) == 8)
     for (T L : seeds.labels)
       if (!(std::abs(double(L)) <= std::ldexp(1.0, 53)))
@@ -204,6 +204,7 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
       throw InternalError(e.what());
     }
     if (largest) mesh = convert(*largest);
+    std::vector<std::uint64_t>().swap(seeds.surfels[i]);  // done with them: the output grows
     LabelSurface& result = out[r];
     result.label = selection.value;
     result.voxels = seeds.voxels[i];
