@@ -537,8 +537,14 @@ void parseLabelList(const std::string& text, LabelsOptions& o) {
   }
 }
 
-void defineLabels(CLI::App& app, LabelsOptions& o, std::string& labels, std::vector<std::string>& seeds,
-                  InputArgs& input) {
+/// The values of `labels` checked after parsing.
+struct LabelsArgs {
+  std::string labels;               ///< --labels, parsed by parseLabelList
+  std::vector<std::string> seeds;   ///< --seed, each x,y,z
+  InputArgs input;
+};
+
+void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
   configure(app);
   setUsage(app, "surftrack labels INPUT -o OUTPUT [options]");
   app.description(
@@ -558,7 +564,7 @@ void defineLabels(CLI::App& app, LabelsOptions& o, std::string& labels, std::vec
       ->option_text("FILE")
       ->group("input and output");
   const std::string which = "which labels and boundaries";
-  app.add_option("--labels", labels, "labels 3,17,42 or a range 10-20 (default: every label)")
+  app.add_option("--labels", args.labels, "labels 3,17,42 or a range 10-20 (default: every label)")
       ->option_text("LIST")
       ->group(which);
   app.add_option("--background", o.background, "the label of no surface (default: 0)")
@@ -566,7 +572,7 @@ void defineLabels(CLI::App& app, LabelsOptions& o, std::string& labels, std::vec
       ->transform(kInteger)
       ->group(which);
   app.add_flag("--largest", o.largest, "only the largest boundary of each label (default: all)")->group(which);
-  app.add_option("--seed", seeds, "only the boundaries reached from voxel x,y,z (walking +x to its\n"
+  app.add_option("--seed", args.seeds, "only the boundaries reached from voxel x,y,z (walking +x to its\n"
                  "label's boundary); repeat for several")
       ->option_text("x,y,z")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
@@ -590,7 +596,7 @@ void defineLabels(CLI::App& app, LabelsOptions& o, std::string& labels, std::vec
         return "--threads takes a number of threads from 0 (all cores) to 1024, got '" + s + "'";
       }))
       ->group("surface options");
-  input = addInputOptions(app, o.input);
+  args.input = addInputOptions(app, o.input);
   addOutputOptions(app, o.out);
   addHelp(app);
 }
@@ -671,35 +677,23 @@ DemoOptions parseDemoOptions(const std::vector<std::string>& args) {
 
 LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   LabelsOptions o;
-  std::string labels;
-  std::vector<std::string> seeds;
-  InputArgs a;
+  LabelsArgs a;
   CLI::App app;
-  defineLabels(app, o, labels, seeds, a);
+  defineLabels(app, o, a);
   parse(app, args);
   rejectExtras(app, "labels");
   if (o.input.path.empty()) throw UsageError("missing the input volume: surftrack labels INPUT -o OUTPUT");
   if (o.output.empty())
     throw UsageError("missing the output: -o DIR/, -o a pattern with {label} or {name}, or -o FILE.ply");
-  if (!labels.empty()) parseLabelList(labels, o);
-  for (const std::string& s : seeds) {
+  if (!a.labels.empty()) parseLabelList(a.labels, o);
+  for (const std::string& s : a.seeds) {
     const auto parts = splitCommas(s);
     o.seeds.push_back(Voxel{int(*toInteger(parts[0])), int(*toInteger(parts[1])), int(*toInteger(parts[2]))});
   }
   if (o.largest && !o.seeds.empty()) throw UsageError("give --largest or --seed, not both");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
-  checkRaw(o.input, a);
+  checkRaw(o.input, a.input);
   return o;
-}
-
-std::string labelsUsage() {
-  LabelsOptions o;
-  std::string labels;
-  std::vector<std::string> seeds;
-  InputArgs a;
-  CLI::App app;
-  defineLabels(app, o, labels, seeds, a);
-  return app.help();
 }
 
 std::string mainUsage() {

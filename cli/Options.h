@@ -110,6 +110,5 @@ std::string mainUsage();
 std::string meshUsage();
 std::string infoUsage();
 std::string demoUsage();
-std::string labelsUsage();
 
 }  // namespace surftrack::cli

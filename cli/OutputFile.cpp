@@ -52,9 +52,16 @@ std::uintmax_t writeMeshFile(const SurfaceMesh& mesh, const std::string& path, b
 
 namespace {
 
-std::string randomSuffix() {
+/// ".NAME.tmp-RANDOM": a hidden temporary name next to NAME (appended piecewise: GCC 12 warns
+/// falsely, -Wrestrict, on "." + std::string).
+std::string hiddenTemporaryName(const std::string& name, const std::string& extension = "") {
   static thread_local std::mt19937_64 rng{std::random_device{}()};
-  return std::to_string(rng());
+  std::string out(1, '.');
+  out += name;
+  out += ".tmp-";
+  out += std::to_string(rng());
+  out += extension;
+  return out;
 }
 
 }  // namespace
@@ -71,7 +78,7 @@ StagedOutputs StagedOutputs::inDirectory(const std::string& directory) {
   requireWritable((dir.parent_path().empty() ? fs::path(".") : dir.parent_path()).string() + "/probe");
   StagedOutputs out;
   out.directory_ = dir.string();
-  out.staging_ = (dir.parent_path() / ("." + dir.filename().string() + ".tmp-" + randomSuffix())).string();
+  out.staging_ = (dir.parent_path() / hiddenTemporaryName(dir.filename().string())).string();
   if (!fs::create_directory(out.staging_, ec))
     throw std::runtime_error("cannot create '" + out.staging_ + "': " + ec.message());
   return out;
@@ -98,7 +105,7 @@ std::string StagedOutputs::temporaryFor(const std::string& target) {
     temporary = (fs::path(staging_) / t.filename()).string();
   } else {
     requireWritable(target);
-    temporary = (t.parent_path() / ("." + t.stem().string() + ".tmp-" + randomSuffix() + t.extension().string())).string();
+    temporary = (t.parent_path() / hiddenTemporaryName(t.stem().string(), t.extension().string())).string();
   }
   files_.emplace_back(temporary, target);
   return temporary;

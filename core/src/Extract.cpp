@@ -39,13 +39,6 @@ namespace {
 /// A boundary of at most this many surfels is a speck (a lone voxel has 6, a 2x2x2 cube 24).
 constexpr std::size_t kSpeckSurfels = 48;
 
-std::string numberText(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
-
 std::string domainText(const Dims& d) {
   std::ostringstream s;
   s << "[0," << d.nx << ")x[0," << d.ny << ")x[0," << d.nz << ")";
@@ -91,7 +84,7 @@ class Stages {
 
 [[noreturn]] void throwEmpty(const VoxelSource&, const Selection& selection) {
   throw InvalidInput("empty selection: no voxel has " +
-                     std::string(selection.isLabel() ? "f = " : "f > ") + numberText(selection.value) +
+                     std::string(selection.isLabel() ? "f = " : "f > ") + numberText(selection.value, 10) +
                      " with a 0-voxel next to it: the image has no boundary surfel");
 }
 
@@ -212,7 +205,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
                        "midpoint mapping");
   if (o.threads < 0) throw InvalidInput("threads " + std::to_string(o.threads) + " is negative (0: all cores)");
   if (!(o.epsilon > 0 && o.epsilon < 0.5))
-    throw InvalidInput("epsilon " + numberText(o.epsilon) + " is outside ]0, 0.5[");
+    throw InvalidInput("epsilon " + numberText(o.epsilon, 10) + " is outside ]0, 0.5[");
 
   const bool scanning = o.seed.kind == Kind::All;
   Stages stages(o, scanning ? 3 : 5, out);  // (the last, "figures", is empty without figures)
@@ -263,15 +256,15 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
         } catch (const std::invalid_argument& e) {
           throw InvalidInput(e.what());
         }
-        const std::string what = "seed point (" + numberText(o.seed.physical[0]) + "," +
-                                 numberText(o.seed.physical[1]) + "," + numberText(o.seed.physical[2]) + ")";
+        const std::string what = "seed point (" + numberText(o.seed.physical[0], 10) + "," +
+                                 numberText(o.seed.physical[1], 10) + "," + numberText(o.seed.physical[2], 10) + ")";
         // A point off the image is most often a point in another frame (RAS for LPS, mm for
         // voxels): say so rather than take the nearest surfel of the image's border.
         for (int a = 0; a < 3; ++a)
           if (!(index[a] >= -0.5 && index[a] <= binary.dims()[a] - 0.5)) {
             std::ostringstream msg;
-            msg << what << " lies outside the image: its voxel index (" << numberText(index[0]) << ","
-                << numberText(index[1]) << "," << numberText(index[2]) << ") is outside the domain "
+            msg << what << " lies outside the image: its voxel index (" << numberText(index[0], 10) << ","
+                << numberText(index[1], 10) << "," << numberText(index[2], 10) << ") is outside the domain "
                 << domainText(binary.dims());
             throw InvalidInput(msg.str());
           }

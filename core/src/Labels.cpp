@@ -26,13 +26,6 @@
 namespace surftrack {
 namespace {
 
-std::string numberText(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
 std::string voxelText(Voxel v) {
   std::ostringstream s;
   s << v;

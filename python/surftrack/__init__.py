@@ -133,6 +133,18 @@ def _split_affine(affine):
     return tuple(spacing), tuple(a[:3, 3]), a[:3, :3] / spacing
 
 
+def _geometry(spacing, origin, direction):
+    """The checked spacing, origin and 3x3 direction of a volume."""
+    spacing = _triple("spacing", spacing, (1.0, 1.0, 1.0))
+    if not all(s > 0 for s in spacing):
+        raise ValueError(f"spacing must be positive, not {spacing}")
+    origin = _triple("origin", origin, (0.0, 0.0, 0.0))
+    direction = np.eye(3) if direction is None else np.asarray(direction, dtype=float)
+    if direction.shape != (3, 3) or not np.all(np.isfinite(direction)):
+        raise ValueError("direction must be a 3x3 matrix of finite numbers")
+    return spacing, origin, direction
+
+
 def _range_note(array: np.ndarray, level: float) -> str:
     lo, hi = float(np.nanmin(array)), float(np.nanmax(array))
     if level < lo or level >= hi:
@@ -203,13 +215,7 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
         if seed is not None or seed_point is not None:
             raise ValueError(f"mode='{mode}' takes no seed")
         seed_kind = mode
-    spacing = _triple("spacing", spacing, (1.0, 1.0, 1.0))
-    if not all(s > 0 for s in spacing):
-        raise ValueError(f"spacing must be positive, not {spacing}")
-    origin = _triple("origin", origin, (0.0, 0.0, 0.0))
-    direction = np.eye(3) if direction is None else np.asarray(direction, dtype=float)
-    if direction.shape != (3, 3) or not np.all(np.isfinite(direction)):
-        raise ValueError("direction must be a 3x3 matrix of finite numbers")
+    spacing, origin, direction = _geometry(spacing, origin, direction)
     # The engine's x, y, z are the array's last, middle, first axes, whatever the memory order:
     # the triangulation of a cube's loops depends on the axes, and the same array must give
     # the same surface. C order reads whole rows at a time (the fast path); other orders read
@@ -278,13 +284,7 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
         if s.ndim != 2 or s.shape[1] != 3 or len(s) == 0 or np.any(s != np.round(s)):
             raise ValueError(f"seeds must be voxel indices [(i, j, k), ...], not {seeds!r}")
         seed_list = [tuple(int(v) for v in row) for row in s]
-    spacing = _triple("spacing", spacing, (1.0, 1.0, 1.0))
-    if not all(s > 0 for s in spacing):
-        raise ValueError(f"spacing must be positive, not {spacing}")
-    origin = _triple("origin", origin, (0.0, 0.0, 0.0))
-    direction = np.eye(3) if direction is None else np.asarray(direction, dtype=float)
-    if direction.shape != (3, 3) or not np.all(np.isfinite(direction)):
-        raise ValueError("direction must be a 3x3 matrix of finite numbers")
+    spacing, origin, direction = _geometry(spacing, origin, direction)
     # The axes as in extract(); the scan reads rows, so a C-ordered copy if need be.
     if not array.flags.c_contiguous:
         array = np.ascontiguousarray(array)
