@@ -69,7 +69,13 @@ std::string tableText(const std::string& path, const std::vector<LabelRow>& rows
 LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   // Everything that can be checked before the work is.
   const OutputKind kind = outputKind(o.output);
-  if (kind == OutputKind::Pattern) meshFormat(o.output);
+  if (kind == OutputKind::Pattern) {
+    meshFormat(o.output);
+    std::string probe = o.output;  // its directory, when the pattern does not vary it
+    replaceAll(probe, "{label}", "0");
+    replaceAll(probe, "{name}", "x");
+    if (fs::path(o.output).parent_path().string().find('{') == std::string::npos) requireWritable(probe);
+  }
   if (kind == OutputKind::OnePly) requireWritable(o.output);
   if (!o.table.empty()) {
     const std::string ext = fs::path(o.table).extension().string();

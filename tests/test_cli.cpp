@@ -821,6 +821,7 @@ TEST_F(Cli, LabelsBadInputIsOneLineAndLeavesNothing) {
                 "cannot read label names");
   expectFailure({"labels", in, "-o", path("out/"), "--labels", "1,x"}, 2, "not an integer label");
   expectFailure({"labels", in, "-o", path("out/"), "--seed", "0,0,0"}, 1, "background");
+  expectFailure({"labels", in, "-o", path("nowhere/{label}.ply")}, 1, "does not exist");
 }
 
 }  // namespace
