@@ -8,8 +8,8 @@
     default backend initialised with N). Both in this process, one after the other, medians of
     --repeat runs; the ratio is that of the two medians of this run.
 (b) A synthetic 512^3 uint32 volume of 2,500 Voronoi cells (uniform random centres, fixed seed;
-    label = 1 + index of the nearest centre, ties to the lowest index; computed with scipy's
-    cKDTree and cached in --cache): every label, all boundaries, on N threads, in a fresh
+    label = 1 + index of the nearest centre as scipy's cKDTree answers it (ties as it breaks them);
+    cached in --cache): every label, all boundaries, on N threads, in a fresh
     process so that its peak resident memory (ru_maxrss) is that of loading the volume and
     extracting, compared with 2 x the volume + the output (the C++ surfaces: 24 bytes a vertex,
     8 a surfel, 12 a triangle).
