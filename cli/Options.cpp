@@ -269,6 +269,23 @@ InputArgs addInputOptions(CLI::App& app, InputOptions& in) {
   return a;
 }
 
+/// -a/--adjacency, --ascii and --threads, in the "surface options" group.
+void addSurfaceOptions(CLI::App& app, AdjacencyPair& pair, bool& ascii, int& threads,
+                       const std::string& threadsHelp) {
+  addValue(
+      app, "-a,--adjacency", "K-L", [&pair](const std::string& s) { pair = parseAdjacencyPair(s); },
+      "26-6 (default), 18-6, 6-18 or 6-26: adjacency of inside-outside voxels")
+      ->check(parsedBy([](const std::string& s) { parseAdjacencyPair(s); }, "K-L"))
+      ->group("surface options");
+  app.add_flag("--ascii", ascii, "text PLY / STL")->group("surface options");
+  app.add_option("--threads", threads, threadsHelp)
+      ->option_text("N")
+      ->check(explained(CLI::Range(0, 1024), [](const std::string& s) {
+        return "--threads takes a number of threads from 0 (all cores) to 1024, got '" + s + "'";
+      }))
+      ->group("surface options");
+}
+
 void addOutputOptions(CLI::App& app, OutputOptions& out) {
   app.add_flag("--json", out.json, "a JSON object on stdout instead of the summary")->group("output");
   app.add_flag("-q,--quiet", out.quiet, "print nothing but errors")->group("output");
@@ -435,11 +452,9 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                                ->group(which);
   a.seedRules = {seed, seedRay, seedPoint, a.largest, a.all};
 
-  addValue(
-      app, "-a,--adjacency", "K-L", [&o](const std::string& s) { o.surface.pair = parseAdjacencyPair(s); },
-      "26-6 (default), 18-6, 6-18 or 6-26: adjacency of inside-outside voxels")
-      ->check(parsedBy([](const std::string& s) { parseAdjacencyPair(s); }, "K-L"))
-      ->group("surface options");
+  addSurfaceOptions(app, o.surface.pair, o.ascii, o.surface.threads,
+                    "threads for the scan of --largest / --all (default 0: all\n"
+                    "cores); the mesh is the same for any number");
   a.mapping = app.add_option("--mapping", mapping,
                              "linear (default with --iso: vertices at the interpolated iso-value)\n"
                              "or midpoint (vertices halfway between the two voxels)")
@@ -449,14 +464,6 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                       CLI::IsMember({"midpoint", "linear"}),
                       [](const std::string& s) { return "expected midpoint or linear, got '" + s + "'"; }))
                   ->group("surface options");
-  app.add_flag("--ascii", o.ascii, "text PLY / STL")->group("surface options");
-  app.add_option("--threads", o.surface.threads, "threads for the scan of --largest / --all (default 0: all\n"
-                 "cores); the mesh is the same for any number")
-      ->option_text("N")
-      ->check(explained(CLI::Range(0, 1024), [](const std::string& s) {
-        return "--threads takes a number of threads from 0 (all cores) to 1024, got '" + s + "'";
-      }))
-      ->group("surface options");
 
   a.input = addInputOptions(app, o.input);
   addOutputOptions(app, o.out);
@@ -583,19 +590,9 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
       ->option_text("FILE")
       ->group(which);
   app.add_flag("--no-label-names", o.noNames, "ignore the sidecar names")->group(which);
-  addValue(
-      app, "-a,--adjacency", "K-L", [&o](const std::string& s) { o.pair = parseAdjacencyPair(s); },
-      "26-6 (default), 18-6, 6-18 or 6-26: adjacency of inside-outside voxels")
-      ->check(parsedBy([](const std::string& s) { parseAdjacencyPair(s); }, "K-L"))
-      ->group("surface options");
-  app.add_flag("--ascii", o.ascii, "text PLY / STL")->group("surface options");
-  app.add_option("--threads", o.threads, "threads for the scan and the labels (default 0: all cores);\n"
-                 "the meshes are the same for any number")
-      ->option_text("N")
-      ->check(explained(CLI::Range(0, 1024), [](const std::string& s) {
-        return "--threads takes a number of threads from 0 (all cores) to 1024, got '" + s + "'";
-      }))
-      ->group("surface options");
+  addSurfaceOptions(app, o.pair, o.ascii, o.threads,
+                    "threads for the scan and the labels (default 0: all cores);\n"
+                    "the meshes are the same for any number");
   args.input = addInputOptions(app, o.input);
   addOutputOptions(app, o.out);
   addHelp(app);
