@@ -1,6 +1,7 @@
 // `surftrack demo`: the README's main job in one command. Builds the phantom, tracks its seed's
 // surface, writes the mesh and prints the summary; with mricron-data installed, does the same
-// for the cortex of a real MRI volume and one region of an atlas.
+// for the cortex of a real MRI volume and one region of an atlas, and writes the whole atlas one
+// file per region (`surftrack labels`).
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -10,6 +11,8 @@
 
 #include "Commands.h"
 #include "Extraction.h"
+#include "LabelNames.h"
+#include "LabelsCommand.h"
 #include "OutputFile.h"
 #include "Phantoms.h"
 #include "Report.h"
@@ -28,22 +31,6 @@ namespace fs = std::filesystem;
 constexpr double kCortexIso = 100;
 /// The AAL atlas region extracted: label 1, the left precentral gyrus (aal.nii.txt).
 constexpr int kAtlasLabel = 1;
-
-/// The name of a label in the atlas's text file ("1 Precentral_L 2001"), or "label N".
-std::string atlasLabelName(const fs::path& atlas, int label) {
-  fs::path txt = atlas;
-  txt.replace_extension();  // aal.nii.gz -> aal.nii
-  txt += ".txt";
-  std::ifstream in(txt);
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream fields(line);
-    int value;
-    std::string name;
-    if (fields >> value >> name && value == label) return name;
-  }
-  return "label" + std::to_string(label);
-}
 
 struct DemoPart {
   std::string title;
@@ -98,6 +85,8 @@ int runDemo(const std::vector<std::string>& args) {
   const fs::path dir(o.outputDir);
   std::vector<DemoRun> runs;
   std::vector<std::string> notes;
+  LabelsRun atlasRegions;
+  std::string atlasCommand;
 
   // 1. The phantom.
   {
@@ -152,7 +141,8 @@ int runDemo(const std::vector<std::string>& args) {
       SurfaceOptions s;
       s.label = kAtlasLabel;
       s.seedMode = SeedMode::Largest;
-      const std::string name = atlasLabelName(atlas, kAtlasLabel);
+      const auto sidecar = labelNamesSidecar(atlas.string());
+      const std::string name = labelName(sidecar ? readLabelNames(*sidecar) : LabelNames{}, kAtlasLabel);
       const std::string mesh = (dir / ("aal-" + name + ".ply")).string();
       DemoRun run{{"atlas region " + std::to_string(kAtlasLabel) + " (" + name + ")", atlas.string(), mesh, ""},
                   extract(volume, atlas.string(), s, mesh, o.out, readSeconds)};
@@ -160,8 +150,21 @@ int runDemo(const std::vector<std::string>& args) {
                          std::to_string(kAtlasLabel) + " --largest";
       runs.push_back(std::move(run));
     }
+    {
+      // 4. The whole atlas, one file per region named from aal.nii.txt (`surftrack labels`). The
+      // directory is the demo's own: replaced when it holds an earlier demo's regions.
+      const fs::path regions = dir / "aal-regions";
+      if (fs::exists(regions / "labels.csv")) fs::remove_all(regions);
+      LabelsOptions l;
+      l.input.path = atlas.string();
+      l.output = regions.string() + "/";
+      atlasRegions = writeLabelMeshes(l);
+      atlasCommand = "surftrack labels " + quoteArg(atlas.string()) + " -o " + quoteArg(l.output);
+    }
   }
 
+  std::size_t regionSurfels = 0, regionBoundaries = 0;
+  for (const LabelRow& r : atlasRegions.rows) regionSurfels += r.surfels, regionBoundaries += r.boundaries;
   if (o.out.json) {
     nlohmann::ordered_json json;
     json["output_dir"] = o.outputDir;
@@ -173,6 +176,16 @@ int runDemo(const std::vector<std::string>& args) {
       result["result"] = extractionJson(r.extraction);
       json["results"].push_back(std::move(result));
     }
+    if (!atlasRegions.rows.empty()) {
+      nlohmann::ordered_json regions;
+      regions["title"] = "atlas regions, one file each";
+      regions["command"] = atlasCommand;
+      regions["output"] = (dir / "aal-regions").string();
+      regions["regions"] = atlasRegions.rows.size();
+      regions["boundaries"] = regionBoundaries;
+      regions["surfels"] = regionSurfels;
+      json["atlas_regions"] = std::move(regions);
+    }
     json["notes"] = notes;
     std::cout << jsonText(json) << std::endl;
   } else if (!o.out.quiet) {
@@ -181,8 +194,15 @@ int runDemo(const std::vector<std::string>& args) {
       printSummary(std::cout, r.extraction);
       std::cout << "  same as   " << r.part.command << "\n\n";
     }
+    if (!atlasRegions.rows.empty()) {
+      std::cout << "== atlas regions, one file each\n  regions   " << atlasRegions.rows.size() << " ("
+                << regionBoundaries << " boundaries, " << regionSurfels << " surfels) in "
+                << (dir / "aal-regions").string() << "/, e.g. " << fs::path(atlasRegions.rows.front().file).filename().string()
+                << "\n  same as   " << atlasCommand << "\n\n";
+    }
     for (const auto& n : notes) std::cout << "note: " << n << "\n";
-    std::cout << "demo: " << runs.size() << " mesh" << (runs.size() == 1 ? "" : "es") << " written to "
+    const std::size_t meshes = runs.size() + atlasRegions.rows.size();
+    std::cout << "demo: " << meshes << " mesh" << (meshes == 1 ? "" : "es") << " written to "
               << o.outputDir << "/\n";
   }
   return 0;

@@ -269,6 +269,23 @@ InputArgs addInputOptions(CLI::App& app, InputOptions& in) {
   return a;
 }
 
+/// -a/--adjacency, --ascii and --threads, in the "surface options" group.
+void addSurfaceOptions(CLI::App& app, AdjacencyPair& pair, bool& ascii, int& threads,
+                       const std::string& threadsHelp) {
+  addValue(
+      app, "-a,--adjacency", "K-L", [&pair](const std::string& s) { pair = parseAdjacencyPair(s); },
+      "26-6 (default), 18-6, 6-18 or 6-26: adjacency of inside-outside voxels")
+      ->check(parsedBy([](const std::string& s) { parseAdjacencyPair(s); }, "K-L"))
+      ->group("surface options");
+  app.add_flag("--ascii", ascii, "text PLY / STL")->group("surface options");
+  app.add_option("--threads", threads, threadsHelp)
+      ->option_text("N")
+      ->check(explained(CLI::Range(0, 1024), [](const std::string& s) {
+        return "--threads takes a number of threads from 0 (all cores) to 1024, got '" + s + "'";
+      }))
+      ->group("surface options");
+}
+
 void addOutputOptions(CLI::App& app, OutputOptions& out) {
   app.add_flag("--json", out.json, "a JSON object on stdout instead of the summary")->group("output");
   app.add_flag("-q,--quiet", out.quiet, "print nothing but errors")->group("output");
@@ -435,11 +452,9 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                                ->group(which);
   a.seedRules = {seed, seedRay, seedPoint, a.largest, a.all};
 
-  addValue(
-      app, "-a,--adjacency", "K-L", [&o](const std::string& s) { o.surface.pair = parseAdjacencyPair(s); },
-      "26-6 (default), 18-6, 6-18 or 6-26: adjacency of inside-outside voxels")
-      ->check(parsedBy([](const std::string& s) { parseAdjacencyPair(s); }, "K-L"))
-      ->group("surface options");
+  addSurfaceOptions(app, o.surface.pair, o.ascii, o.surface.threads,
+                    "threads for the scan of --largest / --all (default 0: all\n"
+                    "cores); the mesh is the same for any number");
   a.mapping = app.add_option("--mapping", mapping,
                              "linear (default with --iso: vertices at the interpolated iso-value)\n"
                              "or midpoint (vertices halfway between the two voxels)")
@@ -449,14 +464,6 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                       CLI::IsMember({"midpoint", "linear"}),
                       [](const std::string& s) { return "expected midpoint or linear, got '" + s + "'"; }))
                   ->group("surface options");
-  app.add_flag("--ascii", o.ascii, "text PLY / STL")->group("surface options");
-  app.add_option("--threads", o.surface.threads, "threads for the scan of --largest / --all (default 0: all\n"
-                 "cores); the mesh is the same for any number")
-      ->option_text("N")
-      ->check(explained(CLI::Range(0, 1024), [](const std::string& s) {
-        return "--threads takes a number of threads from 0 (all cores) to 1024, got '" + s + "'";
-      }))
-      ->group("surface options");
 
   a.input = addInputOptions(app, o.input);
   addOutputOptions(app, o.out);
@@ -511,6 +518,86 @@ void defineDemo(CLI::App& app, DemoOptions& o) {
   addHelp(app);
 }
 
+const char* const kLabelsSummary = "every label of a label image as a closed surface";
+
+/// --labels: "3,17,42" or one range "10-20" / "10..20".
+void parseLabelList(const std::string& text, LabelsOptions& o) {
+  const auto parts = splitCommas(text);
+  for (const std::string& part : parts) {
+    std::size_t dash = part.find("..");
+    std::size_t skip = 2;
+    if (dash == std::string::npos && part.size() > 1) {
+      dash = part.find('-', 1);
+      skip = 1;
+    }
+    if (dash != std::string::npos) {
+      const auto a = toInteger(part.substr(0, dash)), b = toInteger(part.substr(dash + skip));
+      if (!a || !b) throw UsageError("--labels: '" + part + "' is not a range A-B of integers");
+      if (*a > *b) throw UsageError("--labels: the range '" + part + "' is empty");
+      if (parts.size() > 1) throw UsageError("--labels: give a list of labels or one range, not both");
+      o.range = std::array<long long, 2>{*a, *b};
+    } else {
+      const auto v = toInteger(part);
+      if (!v) throw UsageError("--labels: '" + part + "' is not an integer label");
+      o.labels.push_back(*v);
+    }
+  }
+}
+
+/// The values of `labels` checked after parsing.
+struct LabelsArgs {
+  std::string labels;               ///< --labels, parsed by parseLabelList
+  std::vector<std::string> seeds;   ///< --seed, each x,y,z
+  InputArgs input;
+};
+
+void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
+  configure(app);
+  setUsage(app, "surftrack labels INPUT -o OUTPUT [options]");
+  app.description(
+      "Extracts every boundary of every label of an integer label image (an atlas, a\n"
+      "segmentation) as closed triangle meshes, in one pass; neighbouring labels share their\n"
+      "interface vertices exactly (midpoint mapping).");
+  addInput(app, o.input);
+  app.add_option("-o,--output", o.output,
+                 "DIR/: one file per label, DIR/{label}_{name}.ply (DIR must not exist or\n"
+                 "be empty); a pattern with {label} and {name} (any of .ply .obj .off .stl);\n"
+                 "or FILE.ply: every label in one PLY with a label property per face and\n"
+                 "per vertex. Outputs are written completely or not at all")
+      ->option_text("OUTPUT")
+      ->group("input and output");
+  app.add_option("--table", o.table, "a table of one row per label (.csv or .json): voxels, surfels,\n"
+                 "boundaries, Euler characteristic, genus, area, volume (physical units)")
+      ->option_text("FILE")
+      ->group("input and output");
+  const std::string which = "which labels and boundaries";
+  app.add_option("--labels", args.labels, "labels 3,17,42 or a range 10-20 (default: every label)")
+      ->option_text("LIST")
+      ->group(which);
+  app.add_option("--background", o.background, "the label of no surface (default: 0)")
+      ->option_text("L")
+      ->transform(kInteger)
+      ->group(which);
+  app.add_flag("--largest", o.largest, "only the largest boundary of each label (default: all)")->group(which);
+  app.add_option("--seed", args.seeds, "only the boundaries reached from voxel x,y,z (walking +x to its\n"
+                 "label's boundary); repeat for several")
+      ->option_text("x,y,z")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(tripleOf({kInteger, kSeedCoordinate}, "expected three integers x,y,z"))
+      ->group(which);
+  app.add_option("--label-names", o.labelNames, "a text file of lines 'value name' (default: the atlas's\n"
+                 "sidecar, aal.nii.txt for aal.nii.gz, when there is one)")
+      ->option_text("FILE")
+      ->group(which);
+  app.add_flag("--no-label-names", o.noNames, "ignore the sidecar names")->group(which);
+  addSurfaceOptions(app, o.pair, o.ascii, o.threads,
+                    "threads for the scan and the labels (default 0: all cores);\n"
+                    "the meshes are the same for any number");
+  args.input = addInputOptions(app, o.input);
+  addOutputOptions(app, o.out);
+  addHelp(app);
+}
+
 void defineMain(CLI::App& app) {
   setUsage(app, "surftrack COMMAND [ARGS]");
   app.description(
@@ -518,6 +605,7 @@ void defineMain(CLI::App& app) {
       "(Lachaud & Montanvert, \"Continuous analogs of digital boundaries\").");
   app.add_subcommand("mesh", kMeshSummary);
   app.add_subcommand("info", kInfoSummary);
+  app.add_subcommand("labels", kLabelsSummary);
   app.add_subcommand("demo", kDemoSummary);
   app.add_flag("--version")->description("print the version and exit")->group("options");
   app.set_help_flag("-h,--help", "print this help and exit")->group("options");
@@ -581,6 +669,27 @@ DemoOptions parseDemoOptions(const std::vector<std::string>& args) {
     if (arg != "--")
       throw UsageError("unknown argument '" + (arg.rfind("--", 0) == 0 ? arg.substr(0, arg.find('=')) : arg) +
                        "' for 'surftrack demo'");
+  return o;
+}
+
+LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
+  LabelsOptions o;
+  LabelsArgs a;
+  CLI::App app;
+  defineLabels(app, o, a);
+  parse(app, args);
+  rejectExtras(app, "labels");
+  if (o.input.path.empty()) throw UsageError("missing the input volume: surftrack labels INPUT -o OUTPUT");
+  if (o.output.empty())
+    throw UsageError("missing the output: -o DIR/, -o a pattern with {label} or {name}, or -o FILE.ply");
+  if (!a.labels.empty()) parseLabelList(a.labels, o);
+  for (const std::string& s : a.seeds) {
+    const auto parts = splitCommas(s);
+    o.seeds.push_back(Voxel{int(*toInteger(parts[0])), int(*toInteger(parts[1])), int(*toInteger(parts[2]))});
+  }
+  if (o.largest && !o.seeds.empty()) throw UsageError("give --largest or --seed, not both");
+  if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
+  checkRaw(o.input, a.input);
   return o;
 }
 

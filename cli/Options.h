@@ -78,9 +78,29 @@ struct DemoOptions {
   OutputOptions out;
 };
 
+/// `surftrack labels`: every label's surface.
+struct LabelsOptions {
+  InputOptions input;
+  /// -o: a directory (DIR/), a name pattern with {label} and/or {name}, or one .ply file.
+  std::string output;
+  std::vector<long long> labels;                   ///< --labels 3,17,42
+  std::optional<std::array<long long, 2>> range;   ///< --labels 10-20 (or 10..20)
+  long long background = 0;                        ///< --background L
+  std::string labelNames;                          ///< --label-names FILE
+  bool noNames = false;                            ///< --no-label-names: ignore a sidecar
+  bool largest = false;                            ///< --largest
+  std::vector<Voxel> seeds;                        ///< --seed x,y,z (repeatable)
+  AdjacencyPair pair = AdjacencyPair::k26_6;
+  int threads = 0;
+  bool ascii = false;
+  std::string table;  ///< --table FILE.csv | FILE.json
+  OutputOptions out;
+};
+
 MeshOptions parseMeshOptions(const std::vector<std::string>& args);
 InfoOptions parseInfoOptions(const std::vector<std::string>& args);
 DemoOptions parseDemoOptions(const std::vector<std::string>& args);
+LabelsOptions parseLabelsOptions(const std::vector<std::string>& args);
 
 /// "+x", "-x", "+y", "-y", "+z", "-z".
 std::string directionName(Direction d);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <random>
 
 #include "MeshIO.h"
 #include "Options.h"
@@ -47,6 +48,81 @@ std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bo
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(path, ec);
   return ec ? 0 : size;
+}
+
+namespace {
+
+/// ".NAME.tmp-RANDOM": a hidden temporary name next to NAME (appended piecewise: GCC 12 warns
+/// falsely, -Wrestrict, on "." + std::string).
+std::string hiddenTemporaryName(const std::string& name, const std::string& extension = "") {
+  static thread_local std::mt19937_64 rng{std::random_device{}()};
+  std::string out(1, '.');
+  out += name;
+  out += ".tmp-";
+  out += std::to_string(rng());
+  out += extension;
+  return out;
+}
+
+}  // namespace
+
+StagedOutputs StagedOutputs::inDirectory(const std::string& directory) {
+  std::error_code ec;
+  fs::path dir(directory);
+  if (dir.filename().empty()) dir = dir.parent_path();  // "out/" -> "out"
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw std::runtime_error("cannot write '" + directory + "': it is a file, not a directory");
+  if (fs::is_directory(dir, ec) && !fs::is_empty(dir, ec))
+    throw std::runtime_error("cannot write into '" + directory +
+                             "': the directory is not empty (a directory of outputs is written whole)");
+  requireWritable((dir.parent_path().empty() ? fs::path(".") : dir.parent_path()).string() + "/probe");
+  StagedOutputs out;
+  out.directory_ = dir.string();
+  out.staging_ = (dir.parent_path() / hiddenTemporaryName(dir.filename().string())).string();
+  if (!fs::create_directory(out.staging_, ec))
+    throw std::runtime_error("cannot create '" + out.staging_ + "': " + ec.message());
+  return out;
+}
+
+StagedOutputs::StagedOutputs(StagedOutputs&& other) noexcept
+    : directory_(std::move(other.directory_)), staging_(std::move(other.staging_)),
+      files_(std::move(other.files_)), committed_(other.committed_) {
+  other.staging_.clear();
+  other.files_.clear();
+}
+
+StagedOutputs::~StagedOutputs() {
+  if (committed_) return;
+  std::error_code ignored;
+  for (const auto& [temporary, target] : files_) fs::remove(temporary, ignored);
+  if (!staging_.empty()) fs::remove_all(staging_, ignored);
+}
+
+std::string StagedOutputs::temporaryFor(const std::string& target) {
+  const fs::path t(target);
+  std::string temporary;
+  if (!staging_.empty()) {
+    temporary = (fs::path(staging_) / t.filename()).string();
+  } else {
+    requireWritable(target);
+    temporary = (t.parent_path() / hiddenTemporaryName(t.stem().string(), t.extension().string())).string();
+  }
+  files_.emplace_back(temporary, target);
+  return temporary;
+}
+
+void StagedOutputs::commit() {
+  std::error_code ec;
+  if (!staging_.empty()) {
+    fs::rename(staging_, directory_, ec);  // replaces an empty directory
+    if (ec) throw std::runtime_error("cannot move the outputs into '" + directory_ + "': " + ec.message());
+  } else {
+    for (const auto& [temporary, target] : files_) {
+      fs::rename(temporary, target, ec);
+      if (ec) throw std::runtime_error("cannot write '" + target + "': " + ec.message());
+    }
+  }
+  committed_ = true;
 }
 
 }  // namespace surftrack::cli

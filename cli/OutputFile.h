@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "Extract.h"
 
@@ -19,5 +21,32 @@ void requireWritable(const std::string& path);
 /// Writes the surface's triangles (binary PLY / STL unless `binary` is false) with OpenMesh's
 /// writers (converter/MeshIO.h writeTriangles); returns the file size.
 std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bool binary);
+
+/// Several output files written completely or not at all: each is written under a temporary
+/// name, and commit() moves them all into place. In a directory of outputs the temporary names
+/// lie in a staging directory next to it, which commit() renames to the directory (which must
+/// then not exist, or be empty); otherwise they lie next to their targets. Whatever commit()
+/// has not moved is removed by the destructor (an error, an exception on the way).
+class StagedOutputs {
+ public:
+  /// Outputs inside `directory`. Throws std::runtime_error (one line) if it is a non-empty
+  /// directory or a file, or its parent is not writable.
+  static StagedOutputs inDirectory(const std::string& directory);
+  /// Outputs anywhere (a name pattern): each target's directory must be writable.
+  StagedOutputs() = default;
+  StagedOutputs(StagedOutputs&&) noexcept;
+  StagedOutputs& operator=(StagedOutputs&&) = delete;
+  ~StagedOutputs();
+
+  /// The temporary name to write `target` to (same extension).
+  std::string temporaryFor(const std::string& target);
+  /// Moves every output into place.
+  void commit();
+
+ private:
+  std::string directory_, staging_;
+  std::vector<std::pair<std::string, std::string>> files_;  ///< (temporary, target)
+  bool committed_ = false;
+};
 
 }  // namespace surftrack::cli

@@ -10,16 +10,22 @@
 
 namespace surftrack::cli {
 
-namespace {
-
 using json = nlohmann::ordered_json;
 
-std::string num(double v, int precision = 6) {
+std::string num(double v, int precision) {
   std::ostringstream s;
   s.precision(precision);
   s << v;
   return s.str();
 }
+
+json number(double v) {
+  if (!std::isfinite(v)) return nullptr;
+  if (v == std::floor(v) && std::abs(v) < 1e15) return static_cast<std::int64_t>(v);
+  return v;
+}
+
+namespace {
 
 std::string voxelText(Voxel v) {
   std::ostringstream s;
@@ -114,13 +120,6 @@ std::string seedText(const Extraction& x) {
   return s.str();
 }
 
-/// A number for JSON: an integer when the value is one (as people write it: 2, not 2.0), null
-/// when it is not finite (JSON has no NaN or infinity).
-json number(double v) {
-  if (!std::isfinite(v)) return nullptr;
-  if (v == std::floor(v) && std::abs(v) < 1e15) return static_cast<std::int64_t>(v);
-  return v;
-}
 
 /// The seed rule's name in the JSON (a switch, not a table indexed by the enum: a new rule is a
 /// -Wswitch warning here, not a read past the table).

@@ -29,6 +29,13 @@ nlohmann::ordered_json volumeJson(const std::string& path, const io::LoadedVolum
 /// file name) replaced by U+FFFD.
 std::string jsonText(const nlohmann::ordered_json& json);
 
+/// A number for people: `precision` significant digits, no trailing zeros.
+std::string num(double v, int precision = 6);
+
+/// A number for JSON: an integer when the value is one (as people write it: 2, not 2.0), null
+/// when it is not finite (JSON has no NaN or infinity).
+nlohmann::ordered_json number(double v);
+
 /// "c=(x,y,z) d=(x,y,z)".
 std::string surfelText(const Surfel& s);
 

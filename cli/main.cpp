@@ -37,7 +37,8 @@ int main(int argc, char** argv) {
     if (command == "mesh") return runMesh(args);
     if (command == "info") return runInfo(args);
     if (command == "demo") return runDemo(args);
-    throw UsageError("unknown command '" + command + "' (expected mesh, info or demo; see surftrack --help)");
+    if (command == "labels") return runLabels(args);
+    throw UsageError("unknown command '" + command + "' (expected mesh, labels, info or demo; see surftrack --help)");
   } catch (const HelpRequested& help) {
     std::cout << help.text;
     return 0;

@@ -1,13 +1,14 @@
 #include "MeshIO.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <array>
-#include <cctype>
 #include <filesystem>
+#include <functional>
 #include <random>
 #include <stdexcept>
 #include <system_error>
@@ -173,6 +174,29 @@ std::string meshExtension(const std::string& path) {
 
 }  // namespace
 
+void writeFileAtomically(const std::string& path, const std::function<bool(const std::string&)>& write) {
+  const fs::path target(path);
+  const fs::path temporary = temporaryPathFor(target, lowerExtension(target));
+  std::error_code ignored;
+  bool written = false;
+  try {
+    written = write(temporary.string());
+  } catch (...) {
+    fs::remove(temporary, ignored);
+    throw;
+  }
+  if (!written) {
+    fs::remove(temporary, ignored);
+    throw std::runtime_error("cannot write '" + path + "'");
+  }
+  std::error_code error;
+  fs::rename(temporary, target, error);
+  if (error) {
+    fs::remove(temporary, ignored);
+    throw std::runtime_error("cannot write '" + path + "': " + error.message());
+  }
+}
+
 void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
                     const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path,
                     bool binary) {
@@ -180,47 +204,19 @@ void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
   OpenMesh::IO::Options options = OpenMesh::IO::Options::Default;
   if (binary && (ext == ".ply" || ext == ".stl")) options += OpenMesh::IO::Options::Binary;
   TriangleListExporter exporter(vertices, triangles);
-  const fs::path target(path);
-  const fs::path temporary = temporaryPathFor(target, ext);
-  std::error_code ignored;
-  const bool written = ext == ".ply" && binary
-                           ? writeBinaryPly(vertices, triangles, temporary.string())
-                           : OpenMesh::IO::IOManager().write(temporary.string(), exporter, options, 12);
-  if (!written) {
-    fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write mesh to '" + path + "'");
-  }
-  std::error_code error;
-  fs::rename(temporary, target, error);
-  if (error) {
-    fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write mesh to '" + path + "': " + error.message());
-  }
+  writeFileAtomically(path, [&](const std::string& temporary) {
+    return ext == ".ply" && binary ? writeBinaryPly(vertices, triangles, temporary)
+                                   : OpenMesh::IO::IOManager().write(temporary, exporter, options, 12);
+  });
 }
 
 void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary) {
-  constexpr std::array<const char*, 4> kFormats = {".ply", ".obj", ".off", ".stl"};
-  const fs::path target(path);
-  const std::string ext = lowerExtension(target);
-  if (std::find(kFormats.begin(), kFormats.end(), ext) == kFormats.end())
-    throw std::invalid_argument("cannot write mesh '" + path + "': unknown extension '" + ext +
-                                "' (expected .ply, .obj, .off or .stl)");
-
+  const std::string ext = meshExtension(path);
   OpenMesh::IO::Options options = OpenMesh::IO::Options::Default;
   if (binary && (ext == ".ply" || ext == ".stl")) options += OpenMesh::IO::Options::Binary;
-
-  const fs::path temporary = temporaryPathFor(target, ext);
-  std::error_code ignored;
-  if (!OpenMesh::IO::write_mesh(mesh, temporary.string(), options, 12)) {
-    fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write mesh to '" + path + "'");
-  }
-  std::error_code error;
-  fs::rename(temporary, target, error);
-  if (error) {
-    fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write mesh to '" + path + "': " + error.message());
-  }
+  writeFileAtomically(path, [&](const std::string& temporary) {
+    return OpenMesh::IO::write_mesh(mesh, temporary, options, 12);
+  });
 }
 
 }  // namespace surftrack

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,5 +27,10 @@ void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary = t
 void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
                     const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path,
                     bool binary = true);
+/// Calls write(temporary) with a fresh file name next to `path` (same directory and extension),
+/// then renames that file over `path`: a reader sees the old file or the whole new one, never a
+/// partial one. If `write` throws or returns false the temporary file is removed and
+/// std::runtime_error names `path`.
+void writeFileAtomically(const std::string& path, const std::function<bool(const std::string& temporary)>& write);
 
 }  // namespace surftrack

@@ -4,6 +4,7 @@
 // voxel of Z^3: voxels outside the domain take the value `outside` (0 unless asked otherwise).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -213,12 +214,16 @@ class LabelImage {
   /// Values of the `count` <= 64 voxels (x0 + i, y, z) as bits i (ThresholdImage::row's
   /// contract): the scanner and the front door read label images a row at a time.
   std::uint64_t row(int x0, int y, int z, int count) const {
-    std::uint64_t bits = 0;
+    auto low = [](int n) { return n <= 0 ? 0 : n >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1; };
     const bool inRow = y >= 0 && z >= 0 && y < image_.dims.ny && z < image_.dims.nz;
-    for (int i = 0; i < count; ++i) {
-      const int x = x0 + i;
-      const bool v = inRow && x >= 0 && x < image_.dims.nx ? image_.at(x, y, z) == label_ : outside_;
-      bits |= std::uint64_t(v) << i;
+    // Bits [lo, hi) lie in the domain; the others take the outside value.
+    const int lo = inRow ? std::clamp(-x0, 0, count) : count;
+    const int hi = inRow ? std::clamp(image_.dims.nx - x0, lo, count) : count;
+    std::uint64_t bits = outside_ ? low(count) & ~(low(hi) & ~low(lo)) : 0;
+    if (lo < hi) {
+      const T* p = &image_.at(x0 + lo, y, z);
+      const std::ptrdiff_t sx = image_.sx;
+      for (int i = lo; i < hi; ++i, p += sx) bits |= std::uint64_t(*p == label_) << i;
     }
     return bits;
   }

@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
 
 #include "Phantoms.h"
 #include "cli/CliTestSupport.h"
@@ -724,6 +727,16 @@ TEST_F(Cli, MricronDemoSurfacesAreClosedManifolds) {
     EXPECT_EQ(jsonNumber(json, "components"), 1.0);
   }
   EXPECT_EQ(r.out.find("mricron-data is not installed"), std::string::npos);
+  // The whole atlas, one closed mesh per region, named from aal.nii.txt.
+  const std::vector<std::string> regions = listDirectory(dir + "/aal-regions");
+  EXPECT_EQ(regions.size(), 117u);  // 116 regions and labels.csv
+  EXPECT_EQ(jsonNumber(r.out, "regions"), 116.0);
+  EXPECT_TRUE(fs::exists(dir + "/aal-regions/1_Precentral_L.ply"));
+  EXPECT_TRUE(fs::exists(dir + "/aal-regions/116_Vermis_10.ply"));
+  for (const std::string& file : {"1_Precentral_L.ply", "116_Vermis_10.ply"}) {
+    const MeshCheck c = checkMeshFile(dir + "/aal-regions/" + file);
+    EXPECT_TRUE(c.read && c.closed && c.manifold) << file;
+  }
 }
 
 TEST_F(Cli, MricronLabelSurfelsEqualTheDirectCount) {
@@ -740,6 +753,106 @@ TEST_F(Cli, MricronLabelSurfelsEqualTheDirectCount) {
     const RunResult r = run({"mesh", atlas.string(), "-o", out, "--label", std::to_string(label), "--all", "--json"});
     expectGoodMesh(r, out, direct, std::nullopt);
   }
+}
+
+
+// --- surftrack labels ------------------------------------------------------------------------
+
+/// Three touching balls of labels 1, 2 and 7 on background 0, a box of label 9 at the border.
+DenseImage<std::uint16_t> labelBalls() {
+  DenseImage<std::uint16_t> image(Dims{24, 20, 18}, 0);
+  addBall(image, Voxel{7, 9, 8}, 5, std::uint16_t(1));
+  addBall(image, Voxel{14, 9, 8}, 4, std::uint16_t(2));
+  addBall(image, Voxel{11, 14, 10}, 3, std::uint16_t(7));
+  for (int z = 0; z < 4; ++z)
+    for (int y = 0; y < 5; ++y)
+      for (int x = 18; x < 24; ++x) image.at(x, y, z) = 9;
+  return image;
+}
+
+TEST_F(Cli, LabelsWritesADirectoryOfClosedMeshesAndATable) {
+  const DenseImage<std::uint16_t> image = labelBalls();
+  const std::string in = path("labels.nrrd"), names = path("names.txt");
+  io::writeVolume(io::AnyVolume(image), in);
+  std::ofstream(names) << "# value name\n1 Left_thing\n2 Right 99\n7 Middle 1234\n";
+  const std::string dir = path("out/"), table = path("table.json");
+  const RunResult r = run({"labels", in, "-o", dir, "--label-names", names, "--table", table, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::map<int, std::string> files = {{1, "1_Left_thing.ply"}, {2, "2_Right.ply"},
+                                            {7, "7_Middle.ply"}, {9, "9_label9.ply"}};
+  std::vector<std::string> expected = {"labels.csv"};
+  for (const auto& [label, file] : files) expected.push_back(file);
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(listDirectory(path("out")), expected);
+  for (const auto& [label, file] : files) {
+    SCOPED_TRACE(file);
+    const std::size_t direct = countBoundarySurfels(image, [l = label](std::uint16_t v) { return v == l; });
+    const MeshCheck c = checkMeshFile(path("out") + "/" + file);
+    ASSERT_TRUE(c.read);
+    EXPECT_TRUE(c.closed);
+    EXPECT_TRUE(c.manifold);
+    EXPECT_EQ(c.vertices, direct);
+    EXPECT_NE(r.out.find("\"surfels\": " + std::to_string(direct)), std::string::npos) << r.out;
+  }
+  const std::string json = readText(table), csv = readText(path("out/labels.csv"));
+  EXPECT_NE(json.find("\"name\": \"Right\""), std::string::npos) << json;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5) << csv;
+  EXPECT_NE(csv.find("9,label9,120,120,"), std::string::npos) << csv;  // 6 x 5 x 4 voxels
+}
+
+TEST_F(Cli, LabelsWritesOnePlyWithALabelPerFaceAndPatterns) {
+  const DenseImage<std::uint16_t> image = labelBalls();
+  const std::string in = path("labels.nrrd");
+  io::writeVolume(io::AnyVolume(image), in);
+  const RunResult r = run({"labels", in, "-o", path("all.ply"), "--labels", "1,7", "--ascii", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::size_t s1 = countBoundarySurfels(image, [](std::uint16_t v) { return v == 1; });
+  const std::size_t s7 = countBoundarySurfels(image, [](std::uint16_t v) { return v == 7; });
+  const std::string ply = readText(path("all.ply"));
+  EXPECT_NE(ply.find("element vertex " + std::to_string(s1 + s7) + "\n"), std::string::npos);
+  EXPECT_NE(ply.find("property int label\nend_header"), std::string::npos);
+  // Every face line ends with its label: count the faces of each.
+  std::istringstream lines(ply.substr(ply.find("end_header\n") + 11));
+  std::string line;
+  std::map<int, std::size_t> faces, vertices;
+  while (std::getline(lines, line)) {
+    std::istringstream f(line);
+    std::vector<double> v;
+    for (double x; f >> x;) v.push_back(x);
+    if (v.size() == 4) ++vertices[int(v[3])];
+    if (v.size() == 5) ++faces[int(v[4])];
+  }
+  EXPECT_EQ(vertices[1], s1);
+  EXPECT_EQ(vertices[7], s7);
+  EXPECT_EQ(faces[1], 2 * s1 - 4);  // one sphere each: F = 2V - 4
+  EXPECT_EQ(faces[7], 2 * s7 - 4);
+
+  const RunResult p = run({"labels", in, "-o", path("mesh-{label}.obj"), "--labels", "2-7", "--quiet"});
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_TRUE(fs::exists(path("mesh-2.obj")));
+  EXPECT_TRUE(fs::exists(path("mesh-7.obj")));
+  EXPECT_FALSE(fs::exists(path("mesh-9.obj")));
+}
+
+TEST_F(Cli, LabelsBadInputIsOneLineAndLeavesNothing) {
+  const DenseImage<std::uint16_t> image = labelBalls();
+  const std::string in = path("labels.nrrd"), floats = path("floats.nrrd");
+  io::writeVolume(io::AnyVolume(image), in);
+  io::writeVolume(io::AnyVolume(DenseImage<float>(Dims{4, 4, 4}, 1.0f)), floats);
+  fs::create_directories(path("full"));
+  std::ofstream(path("full/x")) << "x";
+  expectFailure({"labels", floats, "-o", path("out/")}, 1, "a label image needs integer voxels");
+  expectFailure({"labels", in, "-o", path("out/"), "--labels", "42"}, 1, "label 42 does not occur");
+  expectFailure({"labels", in, "-o", path("out/"), "--labels", "3-6"}, 1, "empty selection");
+  expectFailure({"labels", in, "-o", path("out/"), "--label-names", path("missing.txt")}, 1,
+                "cannot read label names");
+  expectFailure({"labels", in, "-o", path("full/")}, 1, "not empty");
+  expectFailure({"labels", in, "-o", path("all.obj")}, 2, "must be .ply");
+  expectFailure({"labels", in, "-o", path("x-{name}.ply"), "--label-names", path("names.txt")}, 1,
+                "cannot read label names");
+  expectFailure({"labels", in, "-o", path("out/"), "--labels", "1,x"}, 2, "not an integer label");
+  expectFailure({"labels", in, "-o", path("out/"), "--seed", "0,0,0"}, 1, "background");
+  expectFailure({"labels", in, "-o", path("nowhere/{label}.ply")}, 1, "does not exist");
 }
 
 }  // namespace

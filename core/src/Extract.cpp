@@ -12,6 +12,7 @@
 #include "FindSeed.h"
 #include "LoopExtraction.h"
 #include "ScanIsoSurface.h"
+#include "PlaceSurface.h"
 #include "SelectionValue.h"
 #include "SourceImage.h"
 #include "TrackComponent.h"
@@ -37,13 +38,6 @@ namespace {
 
 /// A boundary of at most this many surfels is a speck (a lone voxel has 6, a 2x2x2 cube 24).
 constexpr std::size_t kSpeckSurfels = 48;
-
-std::string numberText(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
 
 std::string domainText(const Dims& d) {
   std::ostringstream s;
@@ -90,7 +84,7 @@ class Stages {
 
 [[noreturn]] void throwEmpty(const VoxelSource&, const Selection& selection) {
   throw InvalidInput("empty selection: no voxel has " +
-                     std::string(selection.isLabel() ? "f = " : "f > ") + numberText(selection.value) +
+                     std::string(selection.isLabel() ? "f = " : "f > ") + numberText(selection.value, 10) +
                      " with a 0-voxel next to it: the image has no boundary surfel");
 }
 
@@ -142,9 +136,11 @@ Surfel resolveSurfelSeed(const SourceImage& binary, const Surfel& s) {
   return s;
 }
 
+}  // namespace
+
 /// Vertex positions in index space by the boundary mapping (paper §3.1); the linear one reads
 /// the gray values of both voxels of each surfel, in one batch, from the source.
-std::vector<std::array<double, 3>> placeVertices(const VoxelSource& source, const TriangleMesh& mesh,
+static std::vector<std::array<double, 3>> placeVertices(const VoxelSource& source, const TriangleMesh& mesh,
                                                  Mapping mapping, const Selection& selection,
                                                  double epsilon) {
   const std::size_t n = mesh.surfels.size();
@@ -178,7 +174,22 @@ std::vector<std::array<double, 3>> placeVertices(const VoxelSource& source, cons
   return points;
 }
 
-}  // namespace
+void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mapping,
+                  const Selection& selection, double epsilon, Surface& out) {
+  const ImageGeometry geometry = source.geometry();
+  out.vertices = placeVertices(source, mesh, mapping, selection, epsilon);
+  for (auto& p : out.vertices) p = geometry.toPhysical(p);
+  out.surfels = std::move(mesh.surfels);
+  out.triangles = std::move(mesh.triangles);
+  if (geometry.handedness() < 0)  // a mirrored frame: keep the normals pointing outwards
+    for (auto& t : out.triangles) std::swap(t[1], t[2]);
+}
+
+void addFigures(Surface& out) {
+  out.components = componentFigures(out.vertices, out.triangles);
+  out.euler = 0;
+  for (const ComponentFigures& c : out.components) out.euler += c.euler;
+}
 
 Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   using Kind = SeedRule::Kind;
@@ -194,7 +205,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
                        "midpoint mapping");
   if (o.threads < 0) throw InvalidInput("threads " + std::to_string(o.threads) + " is negative (0: all cores)");
   if (!(o.epsilon > 0 && o.epsilon < 0.5))
-    throw InvalidInput("epsilon " + numberText(o.epsilon) + " is outside ]0, 0.5[");
+    throw InvalidInput("epsilon " + numberText(o.epsilon, 10) + " is outside ]0, 0.5[");
 
   const bool scanning = o.seed.kind == Kind::All;
   Stages stages(o, scanning ? 3 : 5, out);  // (the last, "figures", is empty without figures)
@@ -245,15 +256,15 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
         } catch (const std::invalid_argument& e) {
           throw InvalidInput(e.what());
         }
-        const std::string what = "seed point (" + numberText(o.seed.physical[0]) + "," +
-                                 numberText(o.seed.physical[1]) + "," + numberText(o.seed.physical[2]) + ")";
+        const std::string what = "seed point (" + numberText(o.seed.physical[0], 10) + "," +
+                                 numberText(o.seed.physical[1], 10) + "," + numberText(o.seed.physical[2], 10) + ")";
         // A point off the image is most often a point in another frame (RAS for LPS, mm for
         // voxels): say so rather than take the nearest surfel of the image's border.
         for (int a = 0; a < 3; ++a)
           if (!(index[a] >= -0.5 && index[a] <= binary.dims()[a] - 0.5)) {
             std::ostringstream msg;
-            msg << what << " lies outside the image: its voxel index (" << numberText(index[0]) << ","
-                << numberText(index[1]) << "," << numberText(index[2]) << ") is outside the domain "
+            msg << what << " lies outside the image: its voxel index (" << numberText(index[0], 10) << ","
+                << numberText(index[1], 10) << "," << numberText(index[2], 10) << ") is outside the domain "
                 << domainText(binary.dims());
             throw InvalidInput(msg.str());
           }
@@ -283,18 +294,12 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   }
 
   stages.begin("place");
-  out.vertices = placeVertices(source, mesh, out.mapping, o.selection, o.epsilon);
-  out.voxelsRead = binary.voxelsRead() + (out.mapping == Mapping::Linear ? 2 * mesh.surfels.size() : 0);
-  for (auto& p : out.vertices) p = geometry.toPhysical(p);
-  out.surfels = std::move(mesh.surfels);
-  out.triangles = std::move(mesh.triangles);
-  if (geometry.handedness() < 0)  // a mirrored frame: keep the normals pointing outwards
-    for (auto& t : out.triangles) std::swap(t[1], t[2]);
+  placeSurface(source, std::move(mesh), out.mapping, o.selection, o.epsilon, out);
+  out.voxelsRead = binary.voxelsRead() + (out.mapping == Mapping::Linear ? 2 * out.surfels.size() : 0);
 
   stages.begin("figures");
-  if (o.figures) out.components = componentFigures(out.vertices, out.triangles);
+  if (o.figures) addFigures(out);
   if (scanning) out.boundariesInImage = out.components.size();
-  for (const ComponentFigures& c : out.components) out.euler += c.euler;
   stages.end();
   // A seeded surface of a handful of voxels in a large image is most likely noise reached by
   // the seed rule, not the object the caller meant.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string>
 #include <type_traits>
 
 #include "Errors.h"
@@ -11,6 +12,14 @@
 #include "VoxelSource.h"
 
 namespace surftrack {
+
+/// A number in messages: `precision` significant digits, no trailing zeros.
+inline std::string numberText(double v, int precision = 17) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
 
 /// Whether `value` is exactly a value of T (integers: in range and integral; floats: finite).
 template <class T>
@@ -31,17 +40,11 @@ T selectionValue(const Selection& selection) {
 
 /// Throws InvalidInput unless `selection` means something for voxels of `type`.
 inline void requireSelectable(ScalarType type, const Selection& selection) {
-  auto text = [](double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-  };
   if (std::isnan(selection.value))
     throw InvalidInput(std::string(selection.isLabel() ? "label" : "iso-value") + " is NaN");
   if (selection.isLabel() &&
       !visitScalarType(type, [&](auto v) { return holdsValue<decltype(v)>(selection.value); }))
-    throw InvalidInput("label " + text(selection.value) + " is not a value of " + toString(type) +
+    throw InvalidInput("label " + numberText(selection.value) + " is not a value of " + toString(type) +
                        " voxels");
 }
 

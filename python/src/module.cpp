@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include <surftrack/Extract.h>
+#include <surftrack/Labels.h>
 
 namespace py = pybind11;
 using namespace surftrack;
@@ -75,13 +76,10 @@ struct Result {
   }
 };
 
-/// Runs extract() on `volume` whose engine axes x, y, z are the array axes order[0..2].
-py::dict extractArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
-                      double value, const std::string& seedKind, std::array<double, 6> seed,
-                      const std::string& adjacency, const std::string& mapping, double epsilon,
-                      std::array<double, 3> spacing, std::array<double, 3> origin,
-                      std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
-                      py::object progress) {
+/// The view of `volume` whose engine axes x, y, z are the array axes order[0..2], with its
+/// geometry given in array axes.
+VolumeView viewOfArray(const py::array& volume, std::array<int, 3> order, std::array<double, 3> spacing,
+                       std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction) {
   if (volume.ndim() != 3)
     throw py::value_error("the volume must be 3-D, not " + std::to_string(volume.ndim()) + "-D");
   const ScalarType type = scalarTypeOfDtype(volume.dtype());
@@ -100,7 +98,52 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     for (int k = 0; k < 3; ++k) view.geometry.direction[k][e] = direction[k][a];
   }
   view.geometry.origin = origin;
+  return view;
+}
 
+/// The arrays and figures of an extracted surface, as the keyword arguments of Python's Surface.
+py::dict surfaceDict(const std::shared_ptr<Result>& r) {
+  const Surface& s = r->surface;
+  const py::ssize_t n = py::ssize_t(s.vertices.size()), m = py::ssize_t(s.triangles.size());
+  static_assert(sizeof(std::array<double, 3>) == 3 * sizeof(double));
+  static_assert(sizeof(std::array<std::uint32_t, 3>) == 3 * sizeof(std::uint32_t));
+  // (A surface is never empty: extract() and extractLabels() throw instead.)
+  py::array vertices = viewOf(const_cast<double*>(s.vertices.front().data()), {n, 3}, r);
+  py::array faces = viewOf(const_cast<std::uint32_t*>(s.triangles.front().data()), {m, 3}, r);
+  // The figures as one (K, 7) array (a dict per component would cost more than the scan on
+  // images with millions of noise specks); the Python layer makes dicts on first use.
+  py::array_t<double> components({py::ssize_t(s.components.size()), py::ssize_t(7)});
+  {
+    auto c = components.mutable_unchecked<2>();
+    for (py::ssize_t i = 0; i < py::ssize_t(s.components.size()); ++i) {
+      const ComponentFigures& f = s.components[std::size_t(i)];
+      const double row[7] = {double(f.surfels), double(f.triangles), double(f.edges), double(f.euler),
+                             f.genus(), f.area, f.volume};
+      for (int k = 0; k < 7; ++k) c(i, k) = row[k];
+    }
+  }
+  py::dict timings;
+  for (const StageTime& t : s.timings) timings[py::str(t.stage)] = t.seconds;
+  py::dict out;
+  out["vertices"] = vertices;
+  out["faces"] = faces;
+  out["result"] = r;
+  out["components"] = components;
+  out["euler"] = s.euler;
+  out["boundaries_in_image"] = s.boundariesInImage;
+  out["mapping"] = toString(s.mapping);
+  out["timings"] = timings;
+  return out;
+}
+
+/// Runs extract() on `volume` whose engine axes x, y, z are the array axes order[0..2].
+py::dict extractArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
+                      double value, const std::string& seedKind, std::array<double, 6> seed,
+                      const std::string& adjacency, const std::string& mapping, double epsilon,
+                      std::array<double, 3> spacing, std::array<double, 3> origin,
+                      std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
+                      py::object progress) {
+  const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
   ExtractOptions o;
   o.selection = selectionKind == "label" ? Selection::label(value) : Selection::threshold(value);
   o.pair = parseAdjacencyPair(adjacency);
@@ -139,36 +182,8 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     py::gil_scoped_release release;
     r->surface = extract(view, o);
   }
+  py::dict out = surfaceDict(r);
   const Surface& s = r->surface;
-  const py::ssize_t n = py::ssize_t(s.vertices.size()), m = py::ssize_t(s.triangles.size());
-  static_assert(sizeof(std::array<double, 3>) == 3 * sizeof(double));
-  static_assert(sizeof(std::array<std::uint32_t, 3>) == 3 * sizeof(std::uint32_t));
-  // (A surface is never empty: extract() throws instead.)
-  py::array vertices = viewOf(const_cast<double*>(s.vertices.front().data()), {n, 3}, r);
-  py::array faces = viewOf(const_cast<std::uint32_t*>(s.triangles.front().data()), {m, 3}, r);
-  // The figures as one (K, 7) array (a dict per component would cost more than the scan on
-  // images with millions of noise specks); the Python layer makes dicts on first use.
-  py::array_t<double> components({py::ssize_t(s.components.size()), py::ssize_t(7)});
-  {
-    auto c = components.mutable_unchecked<2>();
-    for (py::ssize_t i = 0; i < py::ssize_t(s.components.size()); ++i) {
-      const ComponentFigures& f = s.components[std::size_t(i)];
-      const double row[7] = {double(f.surfels), double(f.triangles), double(f.edges), double(f.euler),
-                             f.genus(), f.area, f.volume};
-      for (int k = 0; k < 7; ++k) c(i, k) = row[k];
-    }
-  }
-  py::dict timings;
-  for (const StageTime& t : s.timings) timings[py::str(t.stage)] = t.seconds;
-  py::dict out;
-  out["vertices"] = vertices;
-  out["faces"] = faces;
-  out["result"] = r;
-  out["components"] = components;
-  out["euler"] = s.euler;
-  out["boundaries_in_image"] = s.boundariesInImage;
-  out["mapping"] = toString(s.mapping);
-  out["timings"] = timings;
   if (s.seed.surfel) {
     py::list c, d;
     std::array<int, 3> ci{}, di{};
@@ -181,6 +196,46 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     if (s.seed.distance) out["seed_distance"] = *s.seed.distance;
   }
   out["warnings"] = s.warnings;
+  return out;
+}
+
+/// Runs extractLabels() on `volume` (engine axes order[0..2]): a dict label -> surfaceDict.
+py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
+                            std::vector<double> labels, std::array<double, 2> range, double background,
+                            const std::string& boundaries, std::vector<std::array<int, 3>> seeds,
+                            const std::string& adjacency, std::array<double, 3> spacing,
+                            std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
+                            int threads, bool figures) {
+  const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
+  LabelOptions o;
+  if (selectionKind == "list") o.labels = LabelSelection::list(std::move(labels));
+  else if (selectionKind == "range") o.labels = LabelSelection::range(range[0], range[1]);
+  o.background = background;
+  o.boundaries = boundaries == "largest" ? LabelBoundaries::Largest
+                 : seeds.empty()         ? LabelBoundaries::All
+                                         : LabelBoundaries::FromSeeds;
+  for (const auto& a : seeds) {
+    Voxel v;
+    for (int e = 0; e < 3; ++e) v[e] = a[order[e]];
+    o.seeds.push_back(v);
+  }
+  o.pair = parseAdjacencyPair(adjacency);
+  o.threads = threads;
+  o.figures = figures;
+  std::vector<LabelSurface> surfaces;
+  {
+    py::gil_scoped_release release;
+    surfaces = extractLabels(view, o);
+  }
+  py::dict out;
+  for (LabelSurface& ls : surfaces) {
+    auto r = std::make_shared<Result>();
+    r->order = order;
+    r->surface = std::move(ls.surface);
+    py::dict d = surfaceDict(r);
+    d["voxels"] = ls.voxels;
+    out[py::int_(std::int64_t(ls.label))] = d;
+  }
   return out;
 }
 
@@ -226,5 +281,6 @@ PYBIND11_MODULE(_surftrack, m) {
       .def("normals", &Result::normals)
       .def("surfels", &Result::surfels);
   m.def("extract_array", &extractArray);
+  m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
 }

@@ -16,7 +16,7 @@ import numpy as np
 from . import _surftrack
 from ._surftrack import Cancelled, InternalError, InvalidInput
 
-__all__ = ["extract", "marching_cubes", "Surface", "InvalidInput", "InternalError", "Cancelled"]
+__all__ = ["extract", "label_surfaces", "marching_cubes", "Surface", "InvalidInput", "InternalError", "Cancelled"]
 
 _ADJACENCIES = ("26-6", "18-6", "6-18", "6-26")
 _MAPPINGS = ("linear", "midpoint", "default")
@@ -38,11 +38,12 @@ class Surface:
     seed_distance  seeded by a voxel or a point: the physical distance to the seed surfel
     warnings  things to know, e.g. that a seeded surface is a speck (also issued as Python
               warnings)
+    voxels    label_surfaces: the voxels of the label
     """
 
     def __init__(self, vertices, faces, result=None, normals=None, surfels=None, components=(),
                  euler=0, boundaries_in_image=0, mapping="midpoint", timings=None,
-                 seed_surfel=None, seed_walk_steps=0, seed_distance=None, warnings=()):
+                 seed_surfel=None, seed_walk_steps=0, seed_distance=None, warnings=(), voxels=None):
         self.vertices = vertices
         self.faces = faces
         self._result = result
@@ -57,6 +58,7 @@ class Surface:
         self.seed_walk_steps = seed_walk_steps
         self.seed_distance = seed_distance
         self.warnings = list(warnings)
+        self.voxels = voxels
 
     @property
     def normals(self) -> np.ndarray:
@@ -131,6 +133,18 @@ def _split_affine(affine):
     return tuple(spacing), tuple(a[:3, 3]), a[:3, :3] / spacing
 
 
+def _geometry(spacing, origin, direction):
+    """The checked spacing, origin and 3x3 direction of a volume."""
+    spacing = _triple("spacing", spacing, (1.0, 1.0, 1.0))
+    if not all(s > 0 for s in spacing):
+        raise ValueError(f"spacing must be positive, not {spacing}")
+    origin = _triple("origin", origin, (0.0, 0.0, 0.0))
+    direction = np.eye(3) if direction is None else np.asarray(direction, dtype=float)
+    if direction.shape != (3, 3) or not np.all(np.isfinite(direction)):
+        raise ValueError("direction must be a 3x3 matrix of finite numbers")
+    return spacing, origin, direction
+
+
 def _range_note(array: np.ndarray, level: float) -> str:
     lo, hi = float(np.nanmin(array)), float(np.nanmax(array))
     if level < lo or level >= hi:
@@ -201,13 +215,7 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
         if seed is not None or seed_point is not None:
             raise ValueError(f"mode='{mode}' takes no seed")
         seed_kind = mode
-    spacing = _triple("spacing", spacing, (1.0, 1.0, 1.0))
-    if not all(s > 0 for s in spacing):
-        raise ValueError(f"spacing must be positive, not {spacing}")
-    origin = _triple("origin", origin, (0.0, 0.0, 0.0))
-    direction = np.eye(3) if direction is None else np.asarray(direction, dtype=float)
-    if direction.shape != (3, 3) or not np.all(np.isfinite(direction)):
-        raise ValueError("direction must be a 3x3 matrix of finite numbers")
+    spacing, origin, direction = _geometry(spacing, origin, direction)
     # The engine's x, y, z are the array's last, middle, first axes, whatever the memory order:
     # the triangulation of a cube's loops depends on the axes, and the same array must give
     # the same surface. C order reads whole rows at a time (the fast path); other orders read
@@ -230,6 +238,60 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     for message in surface.warnings:
         _warnings.warn(message, stacklevel=2)
     return surface
+
+
+def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=None,
+                   background: int = 0, boundaries: str = "all", seeds: Optional[Sequence] = None,
+                   adjacency: str = "26-6", spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
+                   direction=None, affine=None, threads: int = 0, figures: bool = True) -> dict:
+    """Every label of an integer label image as a closed surface: a dict label -> Surface.
+
+    One scan of the image finds every label's boundaries; each label's are tracked and
+    converted, labels in parallel (``threads``, 0: all cores). Vertices are surfel midpoints,
+    so two touching labels share their interface vertices exactly. ``only`` lists the labels
+    wanted (each must occur), ``label_range=(first, last)`` takes those in between; the
+    ``background`` label gets no surface. ``boundaries`` is "all" (default) or "largest" per
+    label; ``seeds`` (voxel indices) keeps only the boundaries reached walking along +k (the last
+    axis) from each seed to its label's boundary, and only their labels. Geometry as in
+    ``extract``.
+    Raises ValueError (surftrack.InvalidInput) / TypeError on bad input.
+    """
+    array = _as_volume(labels)
+    if array.dtype.kind not in "biu":
+        raise ValueError(f"a label image needs integer voxels: this one has {array.dtype} voxels")
+    if affine is not None:
+        spacing, origin, direction = _split_affine(affine)
+    if only is not None and label_range is not None:
+        raise ValueError("give only= or label_range=, not both")
+    if boundaries not in ("all", "largest"):
+        raise ValueError(f"unknown boundaries '{boundaries}': expected 'all' or 'largest'")
+    if boundaries == "largest" and seeds is not None:
+        raise ValueError("boundaries='largest' takes no seeds")
+    if adjacency not in _ADJACENCIES:
+        raise ValueError(f"unsupported adjacency pair '{adjacency}': expected one of "
+                         + ", ".join(_ADJACENCIES))
+    kind, values, bounds = "all", [], (0.0, 0.0)
+    if only is not None:
+        kind, values = "list", [float(v) for v in np.asarray(only).reshape(-1)]
+    elif label_range is not None:
+        r = tuple(float(v) for v in label_range)
+        if len(r) != 2:
+            raise ValueError(f"label_range must be (first, last), not {label_range!r}")
+        kind, bounds = "range", r
+    seed_list = []
+    if seeds is not None:
+        s = np.asarray(seeds)
+        if s.ndim != 2 or s.shape[1] != 3 or len(s) == 0 or np.any(s != np.round(s)):
+            raise ValueError(f"seeds must be voxel indices [(i, j, k), ...], not {seeds!r}")
+        seed_list = [tuple(int(v) for v in row) for row in s]
+    spacing, origin, direction = _geometry(spacing, origin, direction)
+    # The axes as in extract(); the scan reads rows, so a C-ordered copy if need be.
+    if not array.flags.c_contiguous:
+        array = np.ascontiguousarray(array)
+    out = _surftrack.label_surfaces_array(array, [2, 1, 0], kind, values, bounds, float(background),
+                                          boundaries, seed_list, adjacency, spacing, origin,
+                                          direction.tolist(), int(threads), bool(figures))
+    return {label: Surface(**fields) for label, fields in out.items()}
 
 
 def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_direction="descent",

@@ -1,0 +1,31 @@
+// The table of `surftrack labels` (docs/cli.md): one row per label, as CSV or JSON.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace surftrack::cli {
+
+struct LabelRow {
+  long long label = 0;
+  std::string name;
+  std::uint64_t voxels = 0;
+  double voxelVolume = 0;  ///< voxels times the physical volume of one voxel
+  std::size_t surfels = 0, triangles = 0, boundaries = 0;
+  long long euler = 0;     ///< of all its boundaries
+  double genus = 0;        ///< sum over its boundaries of (2 - chi) / 2
+  double area = 0, volume = 0;  ///< physical: area and volume enclosed by the mesh
+  std::string file;        ///< its mesh file ("" in one PLY)
+};
+
+/// The table as CSV: a header line, then one line per row (a field with a comma or a quote is
+/// quoted).
+std::string labelTableCsv(const std::vector<LabelRow>& rows);
+
+/// The table as a JSON array of objects with the CSV's columns as keys.
+nlohmann::ordered_json labelTableJson(const std::vector<LabelRow>& rows);
+
+}  // namespace surftrack::cli

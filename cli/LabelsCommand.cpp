@@ -1,0 +1,191 @@
+// `surftrack labels INPUT -o OUTPUT [options]`: extractLabels (docs/api.md, "Label maps") on a
+// volume file, the meshes written one file per label or as one PLY, with a table per label.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <set>
+#include <variant>
+
+#include <nlohmann/json.hpp>
+
+#include "LabelsCommand.h"
+
+#include "Commands.h"
+#include "LabelNames.h"
+#include "Labels.h"
+#include "MeshIO.h"
+#include "OutputFile.h"
+#include "Report.h"
+
+namespace surftrack::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+enum class OutputKind { Directory, Pattern, OnePly };
+
+OutputKind outputKind(const std::string& output) {
+  if (output.find("{label}") != std::string::npos || output.find("{name}") != std::string::npos)
+    return OutputKind::Pattern;
+  std::error_code ec;
+  if (output.back() == '/' || fs::is_directory(output, ec)) return OutputKind::Directory;
+  if (meshFormat(output) != "ply")
+    throw UsageError("one file of every label must be .ply (it carries a label per face): '" + output +
+                     "'; give DIR/ or a pattern with {label} for other formats");
+  return OutputKind::OnePly;
+}
+
+void replaceAll(std::string& text, const std::string& from, const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+}
+
+/// A name as part of a file name: '/' and spaces become '_'.
+std::string fileSafe(std::string name) {
+  for (char& ch : name)
+    if (ch == '/' || ch == ' ' || ch == '\\') ch = '_';
+  return name;
+}
+
+/// Writes `text` to `path` (a temporary file renamed over it).
+void writeText(const std::string& path, const std::string& text) {
+  writeFileAtomically(path, [&](const std::string& temporary) {
+    std::ofstream out(temporary, std::ios::binary);
+    out << text;
+    out.close();
+    return bool(out);
+  });
+}
+
+std::string tableText(const std::string& path, const std::vector<LabelRow>& rows) {
+  return fs::path(path).extension() == ".json" ? jsonText(labelTableJson(rows)) + "\n" : labelTableCsv(rows);
+}
+
+}  // namespace
+
+LabelsRun writeLabelMeshes(const LabelsOptions& o) {
+  // Everything that can be checked before the work is.
+  const OutputKind kind = outputKind(o.output);
+  if (kind == OutputKind::Pattern) {
+    meshFormat(o.output);
+    std::string probe = o.output;  // its directory, when the pattern does not vary it
+    replaceAll(probe, "{label}", "0");
+    replaceAll(probe, "{name}", "x");
+    if (fs::path(o.output).parent_path().string().find('{') == std::string::npos) requireWritable(probe);
+  }
+  if (kind == OutputKind::OnePly) requireWritable(o.output);
+  if (!o.table.empty()) {
+    const std::string ext = fs::path(o.table).extension().string();
+    if (ext != ".csv" && ext != ".json")
+      throw UsageError("--table '" + o.table + "': the extension must be .csv or .json");
+    requireWritable(o.table);
+  }
+  LabelNames names;
+  std::string namesFile;
+  if (!o.labelNames.empty()) {
+    namesFile = o.labelNames;
+  } else if (!o.noNames) {
+    if (const auto sidecar = labelNamesSidecar(o.input.path)) namesFile = *sidecar;
+  }
+  if (!namesFile.empty()) names = readLabelNames(namesFile);
+  StagedOutputs staged = kind == OutputKind::Directory ? StagedOutputs::inDirectory(o.output) : StagedOutputs();
+
+  StageClock clock;
+  LabelsRun run;
+  run.namesFile = namesFile;
+  std::vector<StageTiming>& timings = run.timings;
+  const io::LoadedVolume volume = readInput(o.input);  // mapped or decoded, never copied
+  clock.lap(timings, "read");
+  const VolumeView& view = volume.view;
+
+  LabelOptions options;
+  if (o.range) options.labels = LabelSelection::range(double((*o.range)[0]), double((*o.range)[1]));
+  else if (!o.labels.empty())
+    options.labels = LabelSelection::list(std::vector<double>(o.labels.begin(), o.labels.end()));
+  options.background = double(o.background);
+  options.boundaries = o.largest         ? LabelBoundaries::Largest
+                       : o.seeds.empty() ? LabelBoundaries::All
+                                         : LabelBoundaries::FromSeeds;
+  options.seeds = o.seeds;
+  options.pair = o.pair;
+  options.threads = o.threads;
+  const std::vector<LabelSurface> surfaces = extractLabels(view, options);
+  clock.lap(timings, "extract");
+
+  // The rows, and the file of each label.
+  const double voxelVolume = std::abs(view.geometry.handedness());
+  std::vector<LabelRow>& rows = run.rows;
+  std::set<std::string> files;
+  for (const LabelSurface& ls : surfaces) {
+    LabelRow r;
+    r.label = (long long)ls.label;
+    r.name = labelName(names, r.label);
+    r.voxels = ls.voxels;
+    r.voxelVolume = double(ls.voxels) * voxelVolume;
+    const Surface& s = ls.surface;
+    r.surfels = s.surfels.size();
+    r.triangles = s.triangles.size();
+    r.boundaries = s.components.size();
+    r.euler = s.euler;
+    r.genus = (2.0 * double(s.components.size()) - double(s.euler)) / 2.0;
+    for (const ComponentFigures& c : s.components) {
+      r.area += c.area;
+      r.volume += c.volume;
+    }
+    if (kind != OutputKind::OnePly) {
+      std::string file = kind == OutputKind::Pattern ? o.output
+                         : names.empty()             ? (fs::path(o.output) / "label_{label}.ply").string()
+                                                     : (fs::path(o.output) / "{label}_{name}.ply").string();
+      replaceAll(file, "{label}", std::to_string(r.label));
+      replaceAll(file, "{name}", fileSafe(r.name));
+      if (!files.insert(file).second)
+        throw UsageError("two labels give the file name '" + file + "': put {label} in the pattern");
+      r.file = file;
+    }
+    rows.push_back(std::move(r));
+  }
+
+  const bool binary = !o.ascii;
+  if (kind == OutputKind::OnePly) {
+    writeLabelSurfaces(surfaces, o.output, binary);
+  } else {
+    for (std::size_t i = 0; i < surfaces.size(); ++i) writeSurface(surfaces[i].surface, staged.temporaryFor(rows[i].file), binary);
+    if (kind == OutputKind::Directory) writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(rows));
+    staged.commit();
+  }
+  if (!o.table.empty()) writeText(o.table, tableText(o.table, rows));
+  clock.lap(timings, "write");
+  return run;
+}
+
+int runLabels(const std::vector<std::string>& args) {
+  const LabelsOptions o = parseLabelsOptions(args);
+  const LabelsRun run = writeLabelMeshes(o);
+  const std::vector<LabelRow>& rows = run.rows;
+  const std::string& namesFile = run.namesFile;
+  if (o.out.json) {
+    nlohmann::ordered_json j;
+    j["input"] = o.input.path;
+    j["output"] = o.output;
+    j["names"] = namesFile;
+    j["adjacency"] = toString(o.pair);
+    j["labels"] = labelTableJson(rows);
+    nlohmann::ordered_json t = nlohmann::ordered_json::object();
+    for (const StageTiming& s : run.timings) t[s.name] = number(s.seconds);
+    j["seconds"] = t;
+    std::cout << jsonText(j) << std::endl;
+  } else if (!o.out.quiet) {
+    std::size_t surfels = 0, boundaries = 0;
+    for (const LabelRow& r : rows) surfels += r.surfels, boundaries += r.boundaries;
+    std::cout << "surftrack labels: " << rows.size() << " label" << (rows.size() == 1 ? "" : "s") << ", "
+              << boundaries << " boundaries, " << surfels << " surfels -> " << o.output << "\n";
+    if (!namesFile.empty()) std::cout << "  names      " << namesFile << "\n";
+    for (const StageTiming& s : run.timings) std::cout << "  " << s.name << std::string(11 - s.name.size(), ' ') << num(s.seconds, 3) << " s\n";
+  }
+  return 0;
+}
+
+}  // namespace surftrack::cli

@@ -1,0 +1,95 @@
+// Label maps (docs/api.md, "Label maps"; docs/theory.md, "Label maps"): the surfaces of every
+// label of an integer label image in one call.
+//
+//   surftrack::LabelOptions options;                       // every label but 0, every boundary
+//   std::vector<surftrack::LabelSurface> surfaces =
+//       surftrack::extractLabels(surftrack::VolumeView::of(labels, dims, geometry), options);
+//
+// For label L the 1-voxels are f = L (paper §3.1). One scan of the rows finds, for every label,
+// its voxel count and seeds on each of its boundaries (tracker/LabelSeeds.h); then each
+// label's boundaries are tracked (§4.3, §5.2) and converted, labels in parallel. Vertices are
+// placed by the midpoint mapping, so where label A touches label B the surfel between an
+// A-voxel and a B-voxel is a vertex of both meshes at the same point.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "AdjacencyPair.h"
+#include "Extract.h"
+#include "VolumeView.h"
+#include "Voxel.h"
+
+namespace surftrack {
+
+/// Which labels to extract. The background label is never extracted.
+struct LabelSelection {
+  enum class Kind {
+    All,    ///< every label of the image
+    List,   ///< these labels; each must occur in the image
+    Range   ///< the labels of the image in [first, last]; at least one must occur
+  };
+  Kind kind = Kind::All;
+  std::vector<double> labels;  ///< List
+  double first = 0, last = 0;  ///< Range, inclusive
+
+  static LabelSelection all() { return {}; }
+  static LabelSelection list(std::vector<double> labels) { return {Kind::List, std::move(labels), 0, 0}; }
+  static LabelSelection range(double first, double last) { return {Kind::Range, {}, first, last}; }
+};
+
+/// Which boundaries of each label to extract.
+enum class LabelBoundaries {
+  All,       ///< every boundary of the label
+  Largest,   ///< the boundary with the most surfels (ties: the first met by the scan)
+  FromSeeds  ///< the boundaries reached from LabelOptions::seeds (only the seeds' labels)
+};
+
+struct LabelOptions {
+  LabelSelection labels;
+  /// The label of no surface: its voxels are 0-voxels of every label.
+  double background = 0;
+  LabelBoundaries boundaries = LabelBoundaries::All;
+  /// FromSeeds: each voxel, of label L, selects the boundary of L through the surfel (c, c + x)
+  /// where c is the last voxel of L met walking from the seed along +x (SeedRule::fromVoxel's
+  /// first ray). A seed's label must be selected and not the background.
+  std::vector<Voxel> seeds;
+  AdjacencyPair pair = AdjacencyPair::k26_6;
+  /// Threads for the scan and for the labels: 0 for all cores. The surfaces are the same for any
+  /// number.
+  int threads = 0;
+  /// Per-component figures of each surface (Surface::components, euler): off for callers that
+  /// need only the meshes.
+  bool figures = true;
+  /// If set and raised, the extraction stops at the next label and throws Cancelled.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+/// The surface of one label: its boundaries wanted, one component each.
+struct LabelSurface {
+  double label = 0;
+  std::uint64_t voxels = 0;  ///< voxels of the label in the image
+  /// selection = Selection::label(label), mapping Midpoint; boundariesInImage: every boundary
+  /// of the label for LabelBoundaries::All and Largest, 0 (not counted) for FromSeeds.
+  Surface surface;
+};
+
+/// The surfaces of the selected labels of `view`, by increasing label.
+/// \pre the labels of the image are exactly representable as doubles (|L| <= 2^53).
+/// \throw InvalidInput for a float volume, a selected label that is not a value of the type,
+///        does not occur or is the background, a range or an image with no label to extract,
+///        a seed outside the domain or on the background or an unselected label, a label
+///        beyond 2^53.
+/// \throw Cancelled when options.cancel is raised.
+/// \throw InternalError when an engine invariant fails (a bug).
+std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options);
+
+/// Writes every surface into one PLY file (binary little-endian, or text): the vertices of each
+/// label in turn (a vertex on an interface once per label it bounds), with an int property
+/// `label` on every vertex and every face. Through a temporary file renamed over `path`.
+/// \throw std::runtime_error naming the path when it cannot be written.
+void writeLabelSurfaces(const std::vector<LabelSurface>& surfaces, const std::string& path, bool binary = true);
+
+}  // namespace surftrack

@@ -1,0 +1,233 @@
+// extractLabels (docs/api.md, "Label maps"): one scan for every label's seeds
+// (tracker/LabelSeeds.h), then, labels in parallel, each label's boundaries tracked
+// (tracker/TrackBoundaries.h), converted (converter/LoopExtraction.h) and placed by the
+// midpoint mapping (paper §3.1) like extract()'s.
+#include "Labels.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <type_traits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "Image.h"
+#include "LabelSeeds.h"
+#include "LoopExtraction.h"
+#include "PlaceSurface.h"
+#include "SelectionValue.h"
+#include "SourceImage.h"
+#include "TrackBoundaries.h"
+
+namespace surftrack {
+namespace {
+
+std::string voxelText(Voxel v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+/// f(i) for i in [0, n), on the arena's threads.
+template <class F>
+void forEachIndex(tbb::task_arena& arena, std::size_t n, F&& f) {
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) f(i);
+    });
+  });
+}
+
+/// The indices in `seeds.labels` of the labels `selection` asks for, in increasing order.
+template <class T>
+std::vector<std::size_t> selectLabels(const LabelSeeds<T>& seeds, const LabelSelection& selection,
+                                      double background) {
+  const std::vector<T>& labels = seeds.labels;
+  std::vector<std::size_t> out;
+  switch (selection.kind) {
+    case LabelSelection::Kind::All:
+      out.resize(labels.size());
+      std::iota(out.begin(), out.end(), std::size_t(0));
+      if (out.empty())
+        throw InvalidInput("empty selection: every voxel has the background label " + numberText(background));
+      break;
+    case LabelSelection::Kind::List:
+      if (selection.labels.empty()) throw InvalidInput("empty selection: the list of labels is empty");
+      for (double L : selection.labels) {
+        requireSelectable(scalarTypeOf<T>(), Selection::label(L));
+        if (L == background) throw InvalidInput("label " + numberText(L) + " is the background");
+        const auto at = std::lower_bound(labels.begin(), labels.end(), T(L));
+        if (at == labels.end() || *at != T(L))
+          throw InvalidInput("label " + numberText(L) + " does not occur in the image");
+        out.push_back(std::size_t(at - labels.begin()));
+      }
+      std::sort(out.begin(), out.end());
+      out.erase(std::unique(out.begin(), out.end()), out.end());
+      break;
+    case LabelSelection::Kind::Range:
+      if (std::isnan(selection.first) || std::isnan(selection.last) || selection.first > selection.last)
+        throw InvalidInput("label range [" + numberText(selection.first) + ", " + numberText(selection.last) +
+                           "] is empty");
+      for (std::size_t i = 0; i < labels.size(); ++i)
+        if (double(labels[i]) >= selection.first && double(labels[i]) <= selection.last) out.push_back(i);
+      if (out.empty())
+        throw InvalidInput("empty selection: no label in [" + numberText(selection.first) + ", " +
+                           numberText(selection.last) + "] occurs in the image (background " +
+                           numberText(background) + ")");
+      break;
+  }
+  return out;
+}
+
+/// For each label index, the seeds (indices into its x-surfels) of the boundaries wanted.
+template <class T>
+std::vector<std::vector<std::size_t>> wantedSeeds(const VolumeRef<T>& image, const LabelSeeds<T>& seeds,
+                                                  const std::vector<std::size_t>& selected,
+                                                  const LabelOptions& o) {
+  std::vector<std::vector<std::size_t>> wanted(seeds.labels.size());
+  if (o.boundaries != LabelBoundaries::FromSeeds) {
+    for (std::size_t i : selected) {
+      wanted[i].resize(seeds.surfels[i].size());
+      std::iota(wanted[i].begin(), wanted[i].end(), std::size_t(0));
+    }
+    return wanted;
+  }
+  if (o.seeds.empty()) throw InvalidInput("boundaries from seeds, but no seed voxel is given");
+  const Dims& dims = image.dims;
+  for (const Voxel& v : o.seeds) {
+    if (!dims.contains(v)) {
+      std::ostringstream msg;
+      msg << "seed voxel " << v << " lies outside the image domain [0," << dims.nx << ")x[0," << dims.ny
+          << ")x[0," << dims.nz << ")";
+      throw InvalidInput(msg.str());
+    }
+    const T L = image.at(v);
+    if (double(L) == o.background)
+      throw InvalidInput("seed voxel " + voxelText(v) + " is on the background label " + numberText(o.background));
+    const std::size_t i = std::size_t(std::lower_bound(seeds.labels.begin(), seeds.labels.end(), L) - seeds.labels.begin());
+    if (!std::binary_search(selected.begin(), selected.end(), i))
+      throw InvalidInput("seed voxel " + voxelText(v) + " has label " + numberText(double(L)) +
+                         ", which is not selected");
+    // The +x ray from the seed: its last voxel of L and the surfel towards +x.
+    int x = v.x;
+    while (x + 1 < dims.nx && image.at(x + 1, v.y, v.z) == L) ++x;
+    const std::uint64_t key = Surfel{Voxel{x, v.y, v.z}, 0}.key();
+    const auto& keys = seeds.surfels[i];
+    const auto at = std::lower_bound(keys.begin(), keys.end(), key);
+    if (at == keys.end() || *at != key) throw InternalError("the scan missed the seed surfel of seed voxel " + voxelText(v));
+    wanted[i].push_back(std::size_t(at - keys.begin()));
+  }
+  return wanted;
+}
+
+void append(TriangleMesh& to, TriangleMesh&& from) {
+  if (to.surfels.empty()) {
+    to = std::move(from);
+    return;
+  }
+  const auto offset = std::uint32_t(to.surfels.size());
+  to.surfels.insert(to.surfels.end(), from.surfels.begin(), from.surfels.end());
+  for (auto t : from.triangles) to.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+}
+
+TriangleMesh convert(const SurfaceGraph& graph) {
+  try {
+    return extractLoops(graph);  // from the bricks the tracker read: the same image
+  } catch (const std::logic_error& e) {
+    throw InternalError(e.what());
+  }
+}
+
+template <class T>
+std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource& source, const LabelOptions& o) {
+  if (!holdsValue<T>(o.background))
+    throw InvalidInput("background " + numberText(o.background) + " is not a value of " +
+                       toString(scalarTypeOf<T>()) + " voxels");
+  const Dims dims = view.dims;
+  const VolumeRef<T> image(static_cast<const T*>(view.data), dims, view.strides[0], view.strides[1], view.strides[2]);
+  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
+
+  // 1. One scan of the rows, slabs of planes in parallel.
+  const int parts = o.threads == 1 ? 1 : std::min(dims.nz, 4 * std::max(1, arena.max_concurrency()));
+  std::vector<LabelSeeds<T>> slabs(std::size_t(std::max(parts, 1)));
+  forEachIndex(arena, slabs.size(), [&](std::size_t k) {
+    const int z0 = int(std::int64_t(dims.nz) * std::int64_t(k) / std::int64_t(slabs.size()));
+    const int z1 = int(std::int64_t(dims.nz) * std::int64_t(k + 1) / std::int64_t(slabs.size()));
+    slabs[k] = scanLabelSeeds(image, T(o.background), z0, z1);
+  });
+  LabelSeeds<T> seeds = mergeLabelSeeds(std::move(slabs));
+  if constexpr (sizeof(T) == 8)
+    for (T L : seeds.labels)
+      if (!(std::abs(double(L)) <= std::ldexp(1.0, 53)))
+        throw InvalidInput("label " + std::to_string(L) + " is beyond 2^53: labels must be exact as doubles");
+
+  std::vector<std::size_t> selected = selectLabels(seeds, o.labels, o.background);
+  const std::vector<std::vector<std::size_t>> wanted = wantedSeeds(image, seeds, selected, o);
+  if (o.boundaries == LabelBoundaries::FromSeeds)  // only the labels of the seeds
+    std::erase_if(selected, [&](std::size_t i) { return wanted[i].empty(); });
+
+  // 2. The labels, largest first so that the last to finish are small.
+  std::vector<std::size_t> order(selected.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return seeds.surfels[selected[a]].size() > seeds.surfels[selected[b]].size();
+  });
+  std::vector<LabelSurface> out(selected.size());
+  forEachIndex(arena, order.size(), [&](std::size_t k) {
+    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+    const std::size_t r = order[k], i = selected[r];
+    const Selection selection = Selection::label(double(seeds.labels[i]));
+    const SourceImage binary(source, selection);
+    TriangleMesh mesh;
+    std::optional<SurfaceGraph> largest;
+    std::size_t boundaries = 0;
+    try {
+      trackBoundaries(binary, seeds.surfels[i], wanted[i], o.pair, [&](SurfaceGraph&& graph) {
+        ++boundaries;
+        if (o.boundaries != LabelBoundaries::Largest)
+          append(mesh, convert(graph));
+        else if (!largest || graph.surfelCount() > largest->surfelCount())
+          largest = std::move(graph);
+      });
+    } catch (const std::logic_error& e) {
+      throw InternalError(e.what());
+    }
+    if (largest) mesh = convert(*largest);
+    std::vector<std::uint64_t>().swap(seeds.surfels[i]);  // done with them: the output grows
+    LabelSurface& result = out[r];
+    result.label = selection.value;
+    result.voxels = seeds.voxels[i];
+    Surface& s = result.surface;
+    s.pair = o.pair;
+    s.selection = selection;
+    s.mapping = Mapping::Midpoint;
+    s.boundariesInImage = o.boundaries == LabelBoundaries::FromSeeds ? 0 : boundaries;
+    placeSurface(source, std::move(mesh), Mapping::Midpoint, selection, 0.25, s);
+    if (o.figures) addFigures(s);
+  });
+  return out;
+}
+
+}  // namespace
+
+std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options) {
+  if (!isInteger(view.type))
+    throw InvalidInput("a label image needs integer voxels: this one has " + toString(view.type) + " voxels");
+  if (options.threads < 0)
+    throw InvalidInput("threads " + std::to_string(options.threads) + " is negative (0: all cores)");
+  if (std::isnan(options.background)) throw InvalidInput("background is NaN");
+  const std::unique_ptr<VoxelSource> source = makeViewSource(view);  // checks the view
+  return visitScalarType(view.type, [&](auto zero) -> std::vector<LabelSurface> {
+    using T = decltype(zero);
+    if constexpr (std::is_integral_v<T>)
+      return extractTyped<T>(view, *source, options);
+    else
+      throw InternalError("extractLabels: a float type passed the integer check");
+  });
+}
+
+}  // namespace surftrack

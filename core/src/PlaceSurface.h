@@ -1,0 +1,21 @@
+// The last stages of an extraction, shared by extract() and extractLabels() (internal to
+// core/): a converted mesh placed as a Surface, and its per-component figures.
+#pragma once
+
+#include "Extract.h"
+#include "TriangleMesh.h"
+
+namespace surftrack {
+
+/// Moves `mesh` into `out`: vertices placed by the boundary mapping (paper §3.1; `epsilon` for
+/// the linear one, which reads the gray values from `source`) and then by the source's geometry,
+/// triangles oriented from the 1-voxels to the 0-voxels in physical space (a mirrored geometry
+/// swaps them).
+/// \pre mapping is Midpoint or Linear (not Default).
+void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mapping,
+                  const Selection& selection, double epsilon, Surface& out);
+
+/// Sets out.components and out.euler from its vertices and triangles.
+void addFigures(Surface& out);
+
+}  // namespace surftrack

@@ -1,0 +1,479 @@
+// extractLabels (docs/api.md, "Label maps") against computations that do not use it: surfel and
+// voxel counts from the 6-adjacent voxel pairs of the image, boundaries and Euler
+// characteristics from voxel components (VoxelComponents.h, MeshChecks.h), the meshes of the
+// binary path (extract with Selection::label), and the positions of the surfels shared by two
+// labels. Random label images from fixed seeds, and every atlas of mricron-data present.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <random>
+#include <set>
+#include <unordered_map>
+
+#include "Extract.h"
+#include "Labels.h"
+#include "MeshChecks.h"
+#include "PairTestName.h"
+#include "ReadVolume.h"
+
+using namespace surftrack;
+namespace ref = surftrack::testing;
+
+namespace {
+
+/// A label image: labels as int64 (converted to the type under test), x fastest.
+struct LabelVolume {
+  Dims dims;
+  std::vector<std::int64_t> labels;
+  std::int64_t at(Voxel v) const { return labels[(std::size_t(v.z) * dims.ny + v.y) * dims.nx + v.x]; }
+};
+
+/// Voxel and surfel counts of each label, counted directly: the 6-adjacent pairs (c, d) with
+/// f(c) = L and d outside the domain or f(d) != L; keys sorted.
+struct DirectCounts {
+  std::map<std::int64_t, std::uint64_t> voxels;
+  std::map<std::int64_t, std::vector<std::uint64_t>> surfels;
+  std::map<std::int64_t, std::pair<Voxel, Voxel>> boxes;  ///< bounding box [lo, hi] of each label
+};
+
+DirectCounts countDirectly(const LabelVolume& v, std::int64_t background) {
+  DirectCounts out;
+  for (int z = 0; z < v.dims.nz; ++z)
+    for (int y = 0; y < v.dims.ny; ++y)
+      for (int x = 0; x < v.dims.nx; ++x) {
+        const Voxel c{x, y, z};
+        const std::int64_t L = v.at(c);
+        if (L == background) continue;
+        ++out.voxels[L];
+        auto [box, added] = out.boxes.try_emplace(L, c, c);
+        if (!added) {
+          box->second.first = {std::min(box->second.first.x, x), std::min(box->second.first.y, y),
+                               std::min(box->second.first.z, z)};
+          box->second.second = {std::max(box->second.second.x, x), std::max(box->second.second.y, y),
+                                std::max(box->second.second.z, z)};
+        }
+        for (Direction n = 0; n < 6; ++n) {
+          const Voxel d = c + unitVector(n);
+          if (!v.dims.contains(d) || v.at(d) != L) out.surfels[L].push_back(Surfel{c, n}.key());
+        }
+      }
+  for (auto& [L, keys] : out.surfels) std::sort(keys.begin(), keys.end());
+  return out;
+}
+
+/// The binary image f = L of a label volume, on its own (ThresholdImage-like) interface.
+struct LabelIs {
+  const LabelVolume* volume;
+  std::int64_t label;
+  const Dims& dims() const { return volume->dims; }
+  bool operator()(int x, int y, int z) const {
+    return volume->dims.contains(x, y, z) && volume->at(Voxel{x, y, z}) == label;
+  }
+  bool operator()(Voxel v) const { return (*this)(v.x, v.y, v.z); }
+};
+
+TriangleMesh meshOf(const Surface& s) { return TriangleMesh{s.surfels, s.triangles}; }
+
+/// The triangles as surfel-key triples, each rotated to start at its smallest key (orientation
+/// kept), sorted: two meshes with the same surfels and triangles give the same list.
+std::vector<std::array<std::uint64_t, 3>> keyTriangles(const Surface& s) {
+  std::vector<std::array<std::uint64_t, 3>> out;
+  for (const auto& t : s.triangles) {
+    std::array<std::uint64_t, 3> k{s.surfels[t[0]].key(), s.surfels[t[1]].key(), s.surfels[t[2]].key()};
+    std::rotate(k.begin(), std::min_element(k.begin(), k.end()), k.end());
+    out.push_back(k);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::uint64_t> sortedSurfelKeys(const Surface& s) { return ref::sortedKeys(s.surfels); }
+
+template <class T>
+std::vector<T> typed(const LabelVolume& v) {
+  return std::vector<T>(v.labels.begin(), v.labels.end());
+}
+
+struct CheckOptions {
+  bool eulerFromVoxels = true;  ///< the voxel Euler identity (cost ~ 27 * volume per label)
+  bool binaryPath = true;       ///< each label alone through extract()
+  std::size_t binaryPathEvery = 1;  ///< only every k-th label through the binary path
+};
+
+/// Every check of the label surfaces `surfaces` of `volume` (a view `view` of it).
+void checkLabelSurfaces(const LabelVolume& volume, const VolumeView& view, std::int64_t background,
+                        AdjacencyPair pair, const std::vector<LabelSurface>& surfaces, CheckOptions checks) {
+  const DirectCounts direct = countDirectly(volume, background);
+  ASSERT_EQ(surfaces.size(), direct.voxels.size()) << "one surface per label but the background";
+  std::map<std::int64_t, const LabelSurface*> byLabel;
+  for (const LabelSurface& ls : surfaces) byLabel[std::int64_t(ls.label)] = &ls;
+  std::size_t k = 0;
+  for (const auto& [L, voxels] : direct.voxels) {
+    SCOPED_TRACE("label " + std::to_string(L));
+    ASSERT_TRUE(byLabel.count(L));
+    const LabelSurface& ls = *byLabel[L];
+    const Surface& s = ls.surface;
+    EXPECT_EQ(ls.voxels, voxels);
+    ASSERT_EQ(s.surfels.size(), direct.surfels.at(L).size()) << "surfels = (L, not L) voxel pairs";
+    long euler = 0;
+    const auto manifold = ref::isClosedManifoldOn(meshOf(s), direct.surfels.at(L), &euler);
+    ASSERT_TRUE(manifold);
+    EXPECT_EQ(euler, s.euler);
+
+    // Boundaries and Euler characteristics from voxel components of f = L, on the bounding box
+    // of L (outside it no voxel is L, as outside the domain).
+    if (checks.eulerFromVoxels) {
+      const auto [lo, hi] = direct.boxes.at(L);
+      LabelVolume box;
+      box.dims = {hi.x - lo.x + 1, hi.y - lo.y + 1, hi.z - lo.z + 1};
+      for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+          for (int x = lo.x; x <= hi.x; ++x) box.labels.push_back(volume.at({x, y, z}));
+      const LabelIs image{&box, L};
+      const ref::VoxelComponents components(image, pair);
+      const auto boundaries = components.boundaries();
+      EXPECT_EQ(s.boundariesInImage, boundaries.size());
+      EXPECT_EQ(s.components.size(), boundaries.size());
+      std::multiset<std::size_t> expectedSizes, sizes;
+      for (const auto& [key, b] : boundaries) expectedSizes.insert(b.size());
+      for (const ComponentFigures& c : s.components) sizes.insert(c.surfels);
+      EXPECT_EQ(sizes, expectedSizes);
+      std::map<int, std::vector<Voxel>> members;
+      for (int z = 0; z < box.dims.nz; ++z)
+        for (int y = 0; y < box.dims.ny; ++y)
+          for (int x = 0; x < box.dims.nx; ++x)
+            if (image(x, y, z)) members[components.component({x, y, z})].push_back({x, y, z});
+      long chi = 0;
+      for (const auto& [O, voxelsOfO] : members) chi += ref::voxelEuler(voxelsOfO, components, O, pair);
+      EXPECT_EQ(s.euler, 2 * chi) << "sum of the boundaries' chi = 2 chi(voxels of L)";
+    }
+
+    // The binary path: this label alone.
+    if (checks.binaryPath && k++ % checks.binaryPathEvery == 0) {
+      ExtractOptions options;
+      options.selection = Selection::label(double(L));
+      options.seed = SeedRule::all();
+      options.pair = pair;
+      options.threads = 1;
+      const Surface alone = extract(view, options);
+      EXPECT_EQ(sortedSurfelKeys(alone), sortedSurfelKeys(s));
+      EXPECT_EQ(keyTriangles(alone), keyTriangles(s)) << "the same triangles as the binary path";
+    }
+  }
+
+  // Interfaces: the surfel (c, d) between an A-voxel and a B-voxel is a vertex of both, at the
+  // same point.
+  std::unordered_map<std::uint64_t, std::array<double, 3>> vertexOf;
+  for (const LabelSurface& ls : surfaces)
+    for (std::size_t v = 0; v < ls.surface.surfels.size(); ++v)
+      vertexOf.emplace(ls.surface.surfels[v].key(), ls.surface.vertices[v]);
+  for (const LabelSurface& ls : surfaces) {
+    const Surface& a = ls.surface;
+    for (std::size_t v = 0; v < a.surfels.size(); ++v) {
+      const Surfel& t = a.surfels[v];
+      if (!volume.dims.contains(t.outside()) || volume.at(t.outside()) == background) continue;
+      const auto it = vertexOf.find(Surfel{t.outside(), opposite(t.n)}.key());
+      ASSERT_NE(it, vertexOf.end()) << "label " << ls.label << ": the other side of " << t << " is no vertex";
+      ASSERT_EQ(it->second, a.vertices[v]) << "label " << ls.label << ": interface vertex " << t;
+    }
+  }
+}
+
+/// A random label image of one of four shapes, from `seed`.
+LabelVolume randomLabels(std::uint32_t seed, std::int64_t& background, std::string& shape) {
+  std::mt19937 rng(seed);
+  auto uniform = [&](int a, int b) { return std::uniform_int_distribution<int>(a, b)(rng); };
+  LabelVolume v;
+  const int kind = int(seed % 4);
+  const int labels = uniform(2, 20);
+  // Label values: small, or spread with gaps (and negative for the signed types below).
+  std::vector<std::int64_t> values(labels);
+  const bool spread = uniform(0, 1);
+  for (int i = 0; i < labels; ++i) values[i] = spread ? std::int64_t(i) * 13 + 5 : i;
+  background = values[uniform(0, labels - 1)];
+  if (uniform(0, 3) == 0) background = 254;  // a background that does not occur (values <= 252)
+  const int lo = kind == 0 ? 3 : 6, hi = kind == 0 ? 9 : 16;
+  v.dims = {uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)};
+  v.labels.resize(v.dims.count());
+  auto index = [&](int x, int y, int z) { return (std::size_t(z) * v.dims.ny + y) * v.dims.nx + x; };
+  switch (kind) {
+    case 0: {  // noise
+      shape = "noise";
+      for (auto& f : v.labels) f = values[uniform(0, labels - 1)];
+      break;
+    }
+    case 1: {  // Voronoi cells
+      shape = "voronoi";
+      std::vector<std::array<int, 3>> centres(labels + uniform(0, 6));
+      std::vector<std::int64_t> cellLabel(centres.size());
+      for (std::size_t c = 0; c < centres.size(); ++c) {
+        centres[c] = {uniform(0, v.dims.nx - 1), uniform(0, v.dims.ny - 1), uniform(0, v.dims.nz - 1)};
+        cellLabel[c] = values[c % labels];
+      }
+      for (int z = 0; z < v.dims.nz; ++z)
+        for (int y = 0; y < v.dims.ny; ++y)
+          for (int x = 0; x < v.dims.nx; ++x) {
+            std::size_t best = 0;
+            int bestD = 1 << 30;
+            for (std::size_t c = 0; c < centres.size(); ++c) {
+              const int dx = x - centres[c][0], dy = y - centres[c][1], dz = z - centres[c][2];
+              const int d = dx * dx + dy * dy + dz * dz;
+              if (d < bestD) bestD = d, best = c;
+            }
+            v.labels[index(x, y, z)] = cellLabel[best];
+          }
+      break;
+    }
+    case 2: {  // balls painted over each other on the background
+      shape = "balls";
+      for (auto& f : v.labels) f = background;
+      for (int b = 0; b < 2 * labels; ++b) {
+        const int cx = uniform(0, v.dims.nx - 1), cy = uniform(0, v.dims.ny - 1), cz = uniform(0, v.dims.nz - 1);
+        const int r2 = uniform(1, 20);
+        const std::int64_t L = values[b % labels];
+        for (int z = 0; z < v.dims.nz; ++z)
+          for (int y = 0; y < v.dims.ny; ++y)
+            for (int x = 0; x < v.dims.nx; ++x)
+              if ((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz) <= r2) v.labels[index(x, y, z)] = L;
+      }
+      break;
+    }
+    default: {  // oblique layers, cut by a second family
+      shape = "layers";
+      const int a = uniform(1, 3), b = uniform(0, 3), c = uniform(0, 3), w = uniform(2, 5);
+      for (int z = 0; z < v.dims.nz; ++z)
+        for (int y = 0; y < v.dims.ny; ++y)
+          for (int x = 0; x < v.dims.nx; ++x)
+            v.labels[index(x, y, z)] = values[((a * x + b * y + c * z) / w + (x + 2 * z) / (w + 2)) % labels];
+      break;
+    }
+  }
+  return v;
+}
+
+constexpr AdjacencyPair kPairs[] = {AdjacencyPair::k26_6, AdjacencyPair::k18_6, AdjacencyPair::k6_18,
+                                    AdjacencyPair::k6_26};
+
+/// Runs the checks on one random image, its labels stored as T.
+template <class T>
+void checkRandomImage(std::uint32_t seed) {
+  std::int64_t background = 0;
+  std::string shape;
+  const LabelVolume volume = randomLabels(seed, background, shape);
+  const AdjacencyPair pair = kPairs[(seed / 4) % 4];
+  SCOPED_TRACE("seed " + std::to_string(seed) + " " + shape + " pair " + toString(pair) + " type " +
+               toString(scalarTypeOf<T>()));
+  const std::vector<T> data = typed<T>(volume);
+  const VolumeView view = VolumeView::of(data.data(), volume.dims);
+  LabelOptions options;
+  options.background = double(background);
+  options.pair = pair;
+  options.threads = 1 + int(seed % 2);
+  std::vector<LabelSurface> surfaces;
+  try {
+    surfaces = extractLabels(view, options);
+  } catch (const InvalidInput& e) {
+    // Only an image of background alone has nothing to extract.
+    const bool allBackground = std::all_of(volume.labels.begin(), volume.labels.end(),
+                                           [&](std::int64_t f) { return f == background; });
+    EXPECT_TRUE(allBackground) << e.what();
+    return;
+  }
+  checkLabelSurfaces(volume, view, background, pair, surfaces, {});
+}
+
+TEST(Labels, FiveHundredRandomLabelImages) {
+  for (std::uint32_t seed = 0; seed < 520; ++seed) {
+    switch (seed % 5) {
+      case 0: checkRandomImage<std::uint16_t>(seed); break;
+      case 1: checkRandomImage<std::int32_t>(seed); break;
+      case 2: checkRandomImage<std::uint8_t>(seed); break;
+      case 3: checkRandomImage<std::uint64_t>(seed); break;
+      default: checkRandomImage<std::int16_t>(seed); break;
+    }
+    if (HasFailure()) return;  // one image's failures are enough to read
+  }
+}
+
+TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
+  for (std::uint32_t seed = 1000; seed < 1040; ++seed) {
+    std::int64_t background = 0;
+    std::string shape;
+    const LabelVolume volume = randomLabels(seed, background, shape);
+    SCOPED_TRACE("seed " + std::to_string(seed) + " " + shape);
+    const std::vector<std::int32_t> data = typed<std::int32_t>(volume);
+    const VolumeView view = VolumeView::of(data.data(), volume.dims);
+    const DirectCounts direct = countDirectly(volume, background);
+    if (direct.voxels.size() < 2) continue;
+    std::vector<double> present;
+    for (const auto& [L, n] : direct.voxels) present.push_back(double(L));
+
+    LabelOptions options;
+    options.background = double(background);
+    options.labels = LabelSelection::list({present.back(), present.front(), present.back()});
+    auto listed = extractLabels(view, options);
+    ASSERT_EQ(listed.size(), 2u);
+    EXPECT_EQ(listed[0].label, present.front());
+    EXPECT_EQ(listed[1].label, present.back());
+
+    options.labels = LabelSelection::range(present[0], present[1]);
+    auto ranged = extractLabels(view, options);
+    ASSERT_EQ(ranged.size(), 2u);
+    EXPECT_EQ(ranged[1].surface.surfels.size(), direct.surfels.at(std::int64_t(present[1])).size());
+
+    options.labels = LabelSelection::all();
+    options.boundaries = LabelBoundaries::Largest;
+    for (const LabelSurface& ls : extractLabels(view, options)) {
+      ExtractOptions alone;
+      alone.selection = Selection::label(ls.label);
+      alone.seed = SeedRule::largest();
+      const Surface s = extract(view, alone);
+      EXPECT_EQ(ls.surface.surfels.size(), s.surfels.size()) << "label " << ls.label;
+      EXPECT_EQ(ls.surface.boundariesInImage, s.boundariesInImage);
+      ASSERT_EQ(ls.surface.components.size(), 1u);
+    }
+
+    // Seeds: the voxel's boundary is that of SeedRule::ray(voxel) for its label.
+    options.boundaries = LabelBoundaries::FromSeeds;
+    std::mt19937 rng(seed);
+    for (int i = 0; i < 3; ++i) {
+      Voxel v{};
+      do {
+        v = {int(rng() % volume.dims.nx), int(rng() % volume.dims.ny), int(rng() % volume.dims.nz)};
+      } while (volume.at(v) == background);
+      options.seeds.push_back(v);
+    }
+    for (const LabelSurface& ls : extractLabels(view, options)) {
+      std::set<std::uint64_t> expected;
+      for (const Voxel& v : options.seeds)
+        if (double(volume.at(v)) == ls.label) {
+          ExtractOptions alone;
+          alone.selection = Selection::label(ls.label);
+          alone.seed = SeedRule::ray(v);
+          for (const Surfel& s : extract(view, alone).surfels) expected.insert(s.key());
+        }
+      const auto got = sortedSurfelKeys(ls.surface);
+      EXPECT_EQ(got, std::vector<std::uint64_t>(expected.begin(), expected.end())) << "label " << ls.label;
+    }
+  }
+}
+
+TEST(Labels, TheSurfacesAreTheSameForAnyNumberOfThreads) {
+  std::int64_t background = 0;
+  std::string shape;
+  const LabelVolume volume = randomLabels(1201, background, shape);
+  const std::vector<std::uint32_t> data = typed<std::uint32_t>(volume);
+  const VolumeView view = VolumeView::of(data.data(), volume.dims);
+  LabelOptions options;
+  options.background = double(background);
+  options.threads = 1;
+  const auto one = extractLabels(view, options);
+  options.threads = 2;
+  const auto two = extractLabels(view, options);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].surface.surfels, two[i].surface.surfels);
+    EXPECT_EQ(one[i].surface.triangles, two[i].surface.triangles);
+  }
+}
+
+TEST(Labels, BadInputIsOneLineInvalidInput) {
+  const Dims dims{4, 4, 4};
+  std::vector<std::uint16_t> labels(dims.count(), 0);
+  labels[21] = 3;
+  const VolumeView view = VolumeView::of(labels.data(), dims);
+  auto message = [&](const LabelOptions& o, const VolumeView& v) -> std::string {
+    try {
+      extractLabels(v, o);
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "no exception";
+  };
+  auto expectMessage = [&](const LabelOptions& o, const VolumeView& v, const std::string& part) {
+    const std::string m = message(o, v);
+    EXPECT_NE(m.find(part), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  };
+  const std::vector<float> floats(dims.count(), 1.0f);
+  expectMessage({}, VolumeView::of(floats.data(), dims), "integer voxels");
+  LabelOptions o;
+  o.labels = LabelSelection::list({42});
+  expectMessage(o, view, "label 42 does not occur");
+  o.labels = LabelSelection::list({});
+  expectMessage(o, view, "empty selection");
+  o.labels = LabelSelection::list({0});
+  expectMessage(o, view, "is the background");
+  o.labels = LabelSelection::list({2.5});
+  expectMessage(o, view, "not a value of uint16");
+  o.labels = LabelSelection::range(4, 10);
+  expectMessage(o, view, "empty selection: no label in [4, 10]");
+  o.labels = LabelSelection::all();
+  o.background = 3;
+  const std::vector<std::uint16_t> threes(dims.count(), 3);
+  expectMessage(o, VolumeView::of(threes.data(), dims), "empty selection");
+  o.background = -1;
+  expectMessage(o, view, "background -1 is not a value of uint16");
+  o.background = 0;
+  o.boundaries = LabelBoundaries::FromSeeds;
+  expectMessage(o, view, "no seed voxel");
+  o.seeds = {Voxel{0, 0, 0}};
+  expectMessage(o, view, "on the background");
+  o.seeds = {Voxel{9, 0, 0}};
+  expectMessage(o, view, "outside the image domain");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The atlases of mricron-data, when installed.
+
+const char* const kAtlasDirectory = "/usr/share/mricron/templates";
+
+class Atlas : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(Atlas, EveryLabelIsAClosedManifoldMeetingItsNeighboursExactly) {
+  const std::string path = std::string(kAtlasDirectory) + "/" + GetParam();
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
+  const io::AnyVolume any = io::readVolume(path);
+  std::visit(
+      [&](const auto& image) {
+        using T = typename std::decay_t<decltype(image)>::value_type;
+        if constexpr (std::is_integral_v<T>) {
+          LabelVolume volume;
+          volume.dims = image.dims();
+          volume.labels.assign(image.data().begin(), image.data().end());
+          const VolumeView view = VolumeView::of(image.data().data(), image.dims(), image.geometry());
+          // Both pairs on the small atlases (2 mm voxels), the default pair on the 1 mm ones (each
+          // ctest under a minute on the 2-vCPU machine while other tests run).
+          for (AdjacencyPair pair : {AdjacencyPair::k26_6, AdjacencyPair::k6_26}) {
+            if (pair != AdjacencyPair::k26_6 && volume.dims.count() > 2000000) continue;
+            SCOPED_TRACE(toString(pair));
+            LabelOptions options;
+            options.pair = pair;
+            const auto surfaces = extractLabels(view, options);
+            // The binary path scans the whole image per label: every 8th label.
+            CheckOptions checks;
+            checks.binaryPathEvery = 8;
+            checkLabelSurfaces(volume, view, 0, pair, surfaces, checks);
+          }
+        } else {
+          FAIL() << path << " holds " << toString(scalarTypeOf<T>()) << " voxels, not labels";
+        }
+      },
+      any);
+}
+
+INSTANTIATE_TEST_SUITE_P(MricronData, Atlas,
+                         ::testing::Values("aal.nii.gz", "AICHAmc.nii.gz", "JHU-WhiteMatter-labels-1mm.nii.gz",
+                                           "JHU-WhiteMatter-labels-2mm.nii.gz", "brodmann.nii.gz",
+                                           "HarvardOxford-cort-maxprob-thr0-1mm.nii.gz", "jhu189.nii.gz"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           std::string name = info.param;
+                           name = name.substr(0, name.find('.'));
+                           for (char& c : name)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return name;
+                         });
+
+}  // namespace
