@@ -135,6 +135,9 @@ struct Surface {
   AdjacencyPair pair = AdjacencyPair::k26_6;
   Selection selection;
   Mapping mapping = Mapping::Midpoint;  ///< the mapping used (never Default)
+  /// The source's geometry: a surfel's segment ]c, d[ is [toPhysical(c), toPhysical(d)] in
+  /// physical space (smooth() keeps every vertex on it).
+  ImageGeometry geometry;
   std::vector<StageTime> timings;
 
   std::size_t vertexCount() const { return vertices.size(); }
