@@ -4,11 +4,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <OpenMesh/Tools/Decimater/DecimaterT.hh>
-#include <OpenMesh/Tools/Decimater/ModHausdorffT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 
+#include "CheckedDecimater.h"
+#include "DistanceGuard.h"
+#include "EmbeddingGuard.h"
 #include "TopologyGuard.h"
 
 namespace surftrack::refine {
@@ -30,33 +31,33 @@ DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p
   report.verticesBefore = mesh.n_vertices();
   mesh.request_vertex_status();
   mesh.request_edge_status();
+  mesh.request_halfedge_status();
   mesh.request_face_status();
   mesh.request_face_normals();
   mesh.update_face_normals();
 
-  using Decimater = OpenMesh::Decimater::DecimaterT<SurfaceMesh>;
-  Decimater decimater(mesh);
+  CheckedDecimaterT<SurfaceMesh> decimater(mesh);
   OpenMesh::Decimater::ModQuadricT<SurfaceMesh>::Handle quadric;
-  OpenMesh::Decimater::ModHausdorffT<SurfaceMesh>::Handle hausdorff;
+  ModSampledDistanceT<SurfaceMesh>::Handle distance;
   OpenMesh::Decimater::ModNormalFlippingT<SurfaceMesh>::Handle flipping;
   ModTopologyGuardT<SurfaceMesh>::Handle guard;
+  ModEmbeddingGuardT<SurfaceMesh>::Handle embedding;
   decimater.add(quadric);
   decimater.add(flipping);
   decimater.add(guard);
+  decimater.add(embedding);
   decimater.module(quadric).unset_max_err();
   if (p.maxError) {
     decimater.module(quadric).set_max_err(*p.maxError * *p.maxError, false);
-    decimater.add(hausdorff);
-    decimater.module(hausdorff).set_tolerance(*p.maxError);
+    decimater.add(distance);
+    decimater.module(distance).set_tolerance(*p.maxError);
   }
   decimater.module(flipping).set_max_normal_deviation(p.maxNormalDeviation);
   if (!decimater.initialize()) throw std::logic_error("decimateSafely: the decimater refused its modules");
-  if (p.targetReduction) {
+  if (p.targetReduction)
     report.targetTriangles = std::size_t(std::llround((1 - *p.targetReduction) * double(report.trianglesBefore)));
-    decimater.decimate_to_faces(0, report.targetTriangles);
-  } else {
-    decimater.decimate();
-  }
+  auto& quadricModule = decimater.module(quadric);
+  decimater.decimateToFaces(report.targetTriangles, [&](const auto& ci) { return quadricModule.collapse_priority(ci); });
   mesh.garbage_collection();
   report.trianglesAfter = mesh.n_faces();
   report.verticesAfter = mesh.n_vertices();

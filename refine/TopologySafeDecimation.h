@@ -2,8 +2,9 @@
 // section 10): halfedge collapses ordered by the quadric error (Garland & Heckbert), each one
 // allowed only if it
 //  - keeps the topology (ModTopologyGuardT: the link condition),
-//  - keeps every removed vertex within `maxError` of the new triangles (ModHausdorffT) and the
-//    quadric error below maxError^2 (ModQuadricT),
+//  - keeps the mesh embedded (ModEmbeddingGuardT: no new triangle meets another one),
+//  - keeps the surface within `maxError` of the original one both ways, on samples
+//    (ModSampledDistanceT), and the quadric error below maxError^2 (ModQuadricT),
 //  - turns no triangle normal by more than `maxNormalDeviation` degrees (ModNormalFlippingT).
 // A halfedge collapse moves no vertex: the survivors keep their points and their surfels.
 #pragma once
@@ -16,8 +17,8 @@
 namespace surftrack::refine {
 
 struct DecimationParameters {
-  /// Largest distance, in the mesh's (physical) units, of a removed vertex to the decimated
-  /// surface; nothing: no bound.
+  /// Largest distance, in the mesh's (physical) units, between the decimated and the original
+  /// surface, both ways, on samples (DistanceGuard.h); nothing: no bound.
   std::optional<double> maxError;
   /// Fraction of the triangles to remove, in [0, 1[ (VTK's TargetReduction); nothing: as many
   /// as the other bounds allow.

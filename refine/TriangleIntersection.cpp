@@ -43,6 +43,35 @@ bool pointInTriangle2(const Point2& p, const std::array<Point2, 3>& t, double to
 
 }  // namespace
 
+double squaredDistanceToTriangle(const Point3& p, const Triangle3& t) {
+  const Point3 &a = t[0], &b = t[1], &c = t[2];
+  const Point3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  auto at = [&](double v, double w) {  // a + v ab + w ac
+    const Point3 q{a[0] + v * ab[0] + w * ac[0], a[1] + v * ab[1] + w * ac[1], a[2] + v * ab[2] + w * ac[2]};
+    const Point3 d = sub(p, q);
+    return dot(d, d);
+  };
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return at(0, 0);
+  const Point3 bp = sub(p, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return at(1, 0);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return at(d1 / (d1 - d3), 0);
+  const Point3 cp = sub(p, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return at(0, 1);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return at(0, d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return at(1 - w, w);
+  }
+  const double denom = 1 / (va + vb + vc);
+  return at(vb * denom, vc * denom);
+}
+
 Point3 triangleNormal(const Triangle3& t) { return cross(sub(t[1], t[0]), sub(t[2], t[0])); }
 
 bool segmentMeetsTriangle(const Point3& a, const Point3& b, const Triangle3& t, double tol) {

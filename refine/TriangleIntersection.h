@@ -25,6 +25,10 @@ bool segmentMeetsTriangle(const Point3& a, const Point3& b, const Triangle3& t, 
 /// \pre neither triangle is degenerate.
 bool trianglesMeetImproperly(const Triangle3& t, const Triangle3& u, int shared, double tolerance);
 
+/// The squared distance from p to the closed triangle t (the closest point by Voronoi regions,
+/// after Ericson, "Real-Time Collision Detection", 5.1.5).
+double squaredDistanceToTriangle(const Point3& p, const Triangle3& t);
+
 /// (b - a) x (c - a): twice the area, along the right-hand-rule normal.
 Point3 triangleNormal(const Triangle3& t);
 
