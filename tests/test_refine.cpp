@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -158,3 +159,130 @@ INSTANTIATE_TEST_SUITE_P(Pairs, RefineRandomImages,
                          ::testing::Values(AdjacencyPair::k26_6, AdjacencyPair::k18_6, AdjacencyPair::k6_18,
                                            AdjacencyPair::k6_26),
                          surftrack::testing::pairTestName);
+
+namespace {
+
+/// Smooths, then decimates, `s` (extracted from `binary`) and checks both results; returns the
+/// decimated surface's figures for further checks.
+template <class BinaryImage>
+void checkSmoothThenDecimate(Surface s, const BinaryImage& binary, double maxError, std::optional<double> reduction,
+                             const std::string& what) {
+  const Shape before = shapeOf(s);
+  ASSERT_TRUE(before.topology.closedOriented) << what << ": " << before.topology.problem;
+  const std::size_t intersectionsBefore = before.selfIntersections;
+  SmoothOptions so;
+  const SmoothReport sr = smooth(s, so);
+  Shape expected = before;
+  expected.selfIntersections = 0;
+  const Shape after = shapeOf(s);
+  EXPECT_TRUE(after.topology.closedOriented) << what << ": " << after.topology.problem;
+  EXPECT_TRUE(after.topology.manifoldVertices) << what << ": " << after.topology.problem;
+  EXPECT_EQ(after.topology.euler, before.topology.euler) << what;
+  EXPECT_EQ(after.topology.components, before.topology.components) << what;
+  // Cubes not embedded in the input are not guarded; none may be added.
+  if (sr.unguardedCubes == 0) EXPECT_EQ(after.selfIntersections, 0u) << what << " smoothed";
+  else EXPECT_LE(after.selfIntersections, intersectionsBefore) << what << " smoothed";
+  expectOnSegments(s, so.epsilon, what + " smoothed");
+  expectVoxelSidesNearSurface(s, binary, what + " smoothed");
+  EXPECT_GT(sr.maxDisplacement, 0) << what;
+
+  const Surface smoothed = s;
+  DecimateOptions dop;
+  dop.maxError = maxError;
+  dop.reduction = reduction;
+  const DecimateReport dr = decimate(s, dop);
+  EXPECT_LT(dr.trianglesAfter, dr.trianglesBefore) << what;
+  const Shape decimated = shapeOf(s);
+  EXPECT_TRUE(decimated.topology.closedOriented) << what << ": " << decimated.topology.problem;
+  EXPECT_TRUE(decimated.topology.manifoldVertices) << what << ": " << decimated.topology.problem;
+  EXPECT_EQ(decimated.topology.euler, before.topology.euler) << what;
+  EXPECT_EQ(decimated.topology.components, before.topology.components) << what;
+  EXPECT_EQ(decimated.selfIntersections, 0u) << what << " decimated";
+  expectWithin(smoothed, s, maxError, what + " decimated");
+  // Survivors are still surfels, on their segments.
+  expectOnSegments(s, so.epsilon, what + " decimated");
+}
+
+template <class T>
+Surface extractFrom(const DenseImage<T>& image, Selection selection, SeedRule seed, Mapping mapping = Mapping::Default) {
+  ExtractOptions o;
+  o.selection = selection;
+  o.seed = seed;
+  o.mapping = mapping;
+  o.threads = 1;
+  return extract(VolumeView::of(image.data().data(), image.dims(), image.geometry()), o);
+}
+
+}  // namespace
+
+// The noisy sphere of Figure 9 (q = 64, 1 % noise): every boundary, midpoint and linear mappings.
+TEST(RefineVolumes, Figure9NoisySphere) {
+  const NoisyPhantom p = makeNoisySphere(64, 0.01);
+  const auto binary = p.binary();
+  checkSmoothThenDecimate(extractFrom(p.image, Selection::threshold(p.iso), SeedRule::all(), Mapping::Midpoint),
+                          binary, 0.5, 0.8, "sphere, midpoint");
+  checkSmoothThenDecimate(extractFrom(p.image, Selection::threshold(p.iso), SeedRule::all(), Mapping::Linear),
+                          binary, 0.5, std::nullopt, "sphere, linear");
+}
+
+// The demo's phantom (sphere minus three cylinders, genus 5), anisotropic and mirrored geometry.
+TEST(RefineVolumes, DemoPhantomInAMirroredAnisotropicFrame) {
+  SphereMinusCylinders p = makeSphereMinusCylinders(48, 0.01);
+  ImageGeometry g;
+  g.spacing = {0.8, 1.0, 1.3};
+  g.origin = {10, -5, 3};
+  g.direction = {{{-1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  p.image.geometry() = g;
+  const auto binary = p.binary();
+  Surface s = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::fromSurfel(p.seed), Mapping::Midpoint);
+  EXPECT_EQ(componentFigures(s.vertices, s.triangles).front().genus(), 5.0);
+  checkSmoothThenDecimate(s, binary, 0.6, 0.9, "phantom");
+}
+
+// The decimation's triangle target, with no error bound: met within 5 %.
+TEST(RefineVolumes, DecimationMeetsItsTarget) {
+  const NoisyPhantom p = makeNoisySphere(48, 0.0);
+  for (double reduction : {0.5, 0.75, 0.9}) {
+    Surface s = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::largest(), Mapping::Midpoint);
+    smooth(s, {});
+    DecimateOptions d;
+    d.reduction = reduction;
+    const DecimateReport r = decimate(s, d);
+    const double target = (1 - reduction) * double(r.trianglesBefore);
+    EXPECT_NEAR(double(s.triangles.size()), target, 0.05 * target) << "reduction " << reduction;
+    const Shape shape = shapeOf(s);
+    EXPECT_EQ(shape.topology.euler, 2);
+    EXPECT_EQ(shape.selfIntersections, 0u);
+  }
+}
+
+TEST(RefineErrors, BadOptionsAndInputsThrowInvalidInput) {
+  const NoisyPhantom p = makeNoisySphere(16, 0.0);
+  Surface s = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::largest(), Mapping::Midpoint);
+  SmoothOptions bad;
+  bad.lambda = 0;
+  EXPECT_THROW(smooth(s, bad), InvalidInput);
+  bad = {};
+  bad.mu = -0.4;  // not below -lambda
+  EXPECT_THROW(smooth(s, bad), InvalidInput);
+  bad = {};
+  bad.epsilon = 0.5;
+  EXPECT_THROW(smooth(s, bad), InvalidInput);
+  EXPECT_THROW(decimate(s, {}), InvalidInput);  // neither bound nor target
+  DecimateOptions d;
+  d.reduction = 1.0;
+  EXPECT_THROW(decimate(s, d), InvalidInput);
+  d.reduction = std::nullopt;
+  d.maxError = -1;
+  EXPECT_THROW(decimate(s, d), InvalidInput);
+  // A decimated surface is no longer a continuous analog: its triangles leave their cubes.
+  d.maxError = 1.0;
+  decimate(s, d);
+  EXPECT_THROW(smooth(s, {}), InvalidInput);
+  // A vertex moved off its segment.
+  Surface t = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::largest(), Mapping::Midpoint);
+  t.vertices[0][0] += 0.25;
+  t.vertices[0][1] += 0.25;
+  t.vertices[0][2] += 0.25;
+  EXPECT_THROW(smooth(t, {}), InvalidInput);
+}
