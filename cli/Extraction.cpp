@@ -66,7 +66,9 @@ io::AnyVolume readInput(const InputOptions& input) {
   return volume;
 }
 
-int extractionStages(const SurfaceOptions& o) { return o.seedMode == SeedMode::All ? 5 : 7; }
+int extractionStages(const SurfaceOptions& o) {
+  return (o.seedMode == SeedMode::All ? 5 : 7) + (o.refine.smoothIterations > 0) + o.refine.decimate();
+}
 
 namespace {
 
@@ -187,6 +189,23 @@ void extractSurface(const io::AnyVolume& volume, const SurfaceOptions& o, Extrac
   x.walkSteps = surface.seed.walkSteps;
   x.boundaries = surface.boundariesInImage;
   x.surfels = surface.surfels.size();
+  for (const ComponentFigures& c : surface.components) x.extractedVolume += c.volume;
+  int next = stage + extractionStages(o) - 1 - (o.refine.smoothIterations > 0) - o.refine.decimate();
+  if (o.refine.smoothIterations > 0) {
+    progress.stage(next++, stageCount, "smoothing");
+    SmoothOptions so;
+    so.iterations = o.refine.smoothIterations;
+    x.smooth = smooth(surface, so);
+    clock.lap(x.timings, "smooth");
+  }
+  if (o.refine.decimate()) {
+    progress.stage(next++, stageCount, "decimating");
+    DecimateOptions d;
+    d.maxError = o.refine.maxError;
+    d.reduction = o.refine.reduction;
+    x.decimate = decimate(surface, d);
+    clock.lap(x.timings, "decimate");
+  }
 
   progress.stage(stage + extractionStages(o) - 1, stageCount, "building the mesh");
   TriangleMesh triangles{std::move(surface.surfels), std::move(surface.triangles)};

@@ -14,6 +14,7 @@
 #include "Options.h"
 #include "Progress.h"
 #include "ReadVolume.h"
+#include "Refine.h"
 #include "SurfaceMesh.h"
 
 namespace surftrack::cli {
@@ -75,6 +76,9 @@ struct Extraction {
   // The result.
   std::vector<std::string> warnings;  ///< printed on stderr (e.g. a speck)
   std::size_t surfels = 0;
+  std::optional<SmoothReport> smooth;      ///< --smooth
+  std::optional<DecimateReport> decimate;  ///< --max-error / --reduce
+  double extractedVolume = 0;              ///< enclosed volume before smoothing and decimation
   SurfaceMesh mesh;
   MeshStats stats;
   std::vector<StageTiming> timings;
@@ -87,7 +91,8 @@ struct Extraction {
   std::uintmax_t bytes = 0;
 };
 
-/// The progress stages extractSurface reports: values, the core's stages, mesh.
+/// The progress stages extractSurface reports: values, the core's stages, smooth and decimate
+/// when asked, mesh.
 int extractionStages(const SurfaceOptions& options);
 
 /// Runs the pipeline on `volume` (already read; `extraction` holds the input fields and the

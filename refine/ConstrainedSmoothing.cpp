@@ -18,6 +18,10 @@ using Vec = std::array<double, 3>;
 
 double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
+/// cos^2 of the largest angle between a segment and the vertex normal for which the move
+/// follows the normal (cos = 0.3, about 72.5 degrees).
+constexpr double kMinNormalCosine2 = 0.09;
+
 void requireParameters(const SmoothingParameters& p) {
   std::ostringstream msg;
   if (p.iterations < 0) msg << "smoothing iterations " << p.iterations << " is negative";
@@ -168,7 +172,7 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
   }
 
   std::vector<double> previous(nv);
-  std::vector<Vec> x(nv);
+  std::vector<Vec> x(nv), normal(nv);
   std::vector<int> halved(nv);
   std::vector<char> queued(nc, 0);
   std::vector<std::uint32_t> queue, cubeVertices;
@@ -176,6 +180,13 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
     for (std::size_t v = 0; v < nv; ++v)
       for (int k = 0; k < 3; ++k) x[v][k] = base[v][k] + t[v] * axis[v][k];
     previous = t;
+    // Area-weighted vertex normals of the current surface.
+    std::fill(normal.begin(), normal.end(), Vec{0, 0, 0});
+    for (const auto& tr : triangle) {
+      const Point3 n = triangleNormal({x[tr[0]], x[tr[1]], x[tr[2]]});
+      for (std::uint32_t v : tr)
+        for (int k = 0; k < 3; ++k) normal[v][k] += n[k];
+    }
     for (std::size_t v = 0; v < nv; ++v) {
       const auto neighbours = ring[v];
       if (neighbours.empty()) continue;
@@ -183,8 +194,16 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
       for (std::uint32_t w : neighbours)
         for (int k = 0; k < 3; ++k) laplacian[k] += x[w][k];
       for (int k = 0; k < 3; ++k) laplacian[k] = laplacian[k] / double(neighbours.size()) - x[v][k];
-      // The move projected on the segment (the orthogonal projection in physical space).
-      t[v] = std::clamp(t[v] + factor * dot(laplacian, axis[v]) * inverseLength2[v], p.epsilon, 1 - p.epsilon);
+      // Only the Laplacian's normal part moves the surface; its tangential part, projected on
+      // the segment, would push the vertex off the surface. So the vertex goes where its
+      // segment meets the plane through x + factor (L . n) n normal to n, unless the segment is
+      // nearly tangent (then the orthogonal projection of the move on the segment).
+      const Vec& n = normal[v];
+      const double nn = dot(n, n), an = dot(axis[v], n);
+      double step;
+      if (an * an > kMinNormalCosine2 * nn * dot(axis[v], axis[v])) step = factor * dot(laplacian, n) / an;
+      else step = factor * dot(laplacian, axis[v]) * inverseLength2[v];
+      t[v] = std::clamp(t[v] + step, p.epsilon, 1 - p.epsilon);
     }
     // The fold check: every guarded cube is checked after the last change of its vertices; a
     // failing cube halves its vertices' moves (or undoes them after `halvings`) and requeues

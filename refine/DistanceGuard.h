@@ -4,7 +4,7 @@
 //    assigned to a current triangle within the tolerance (as OpenMesh's ModHausdorffT does for
 //    the vertices alone); a collapse must find such a triangle, among those it creates or the
 //    others nearby, for every sample of the triangles it removes or replaces;
-//  - decimated -> original: the points of barycentric coordinates (i, j, k) / 6 of every
+//  - decimated -> original: the points of barycentric coordinates (i, j, k) / 4 of every
 //    triangle a collapse creates lie within the tolerance of an original triangle.
 // Nearby triangles come from uniform grids (TriangleGrid.h), so this is not limited to a
 // one-ring.
@@ -33,7 +33,7 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
   }
 
   /// The barycentric step of the samples of a created triangle: 1 / kSteps.
-  static constexpr int kSteps = 6;
+  static constexpr int kSteps = 4;
 
   void set_tolerance(double tolerance) { tolerance_ = tolerance; }
 
@@ -41,8 +41,13 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     MeshT& m = Base::mesh();
     if (!samplesOf_.is_valid()) m.add_property(samplesOf_);
     original_.clear();
+    lastHit_ = 0;
     samples_.clear();
-    const double cell = std::max(tolerance_, 1e-300) * 2;
+    // Cells about twice the larger of the tolerance and the mean edge length: a triangle
+    // meets a few cells, a query a few more.
+    double edges = 0;
+    for (auto e : m.edges()) edges += m.calc_edge_length(e);
+    const double cell = 2 * std::max(tolerance_, m.n_edges() ? edges / double(m.n_edges()) : 1.0);
     originalGrid_.clear(cell);
     currentGrid_.clear(cell);
     for (auto f : m.faces()) {
@@ -107,9 +112,19 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     MeshT& m = Base::mesh();
     created_.clear();
     for (auto f : m.vf_range(ci.v1)) currentGrid_.insert(std::uint32_t(f.idx()), triangleOf(f));
+    const double e2 = tolerance_ * tolerance_;
     for (std::uint32_t s : pending_) {
+      // The nearest of v1's triangles if one is within the tolerance, else the nearest nearby.
       FaceHandle best;
-      nearCurrent(samples_[s], tolerance_ * tolerance_, typename MeshT::VertexHandle(), &best);
+      double bestD = e2;
+      for (auto f : m.vf_range(ci.v1)) {
+        const double d = squaredDistanceToTriangle(samples_[s], triangleOf(f));
+        if (d <= bestD) {
+          bestD = d;
+          best = f;
+        }
+      }
+      if (!best.is_valid()) nearCurrent(samples_[s], e2, typename MeshT::VertexHandle(), &best);
       if (!best.is_valid()) best = *m.vf_range(ci.v1).begin();  // (the check found one; rounding)
       m.property(samplesOf_, best).push_back(s);
     }
@@ -128,10 +143,15 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     list.push_back(std::uint32_t(samples_.size()));
     samples_.push_back(p);
   }
-  bool nearOriginal(const Point3& p, double e2) const {
+  bool nearOriginal(const Point3& p, double e2) {
+    // Neighbouring samples are most often near the same original triangle: try it first.
+    if (squaredDistanceToTriangle(p, original_[lastHit_]) <= e2) return true;
     bool found = false;
     originalGrid_.near({p, p, p}, tolerance_, [&](std::uint32_t id) {
-      found = found || squaredDistanceToTriangle(p, original_[id]) <= e2;
+      if (!found && squaredDistanceToTriangle(p, original_[id]) <= e2) {
+        found = true;
+        lastHit_ = id;
+      }
     });
     return found;
   }
@@ -169,6 +189,7 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
   std::vector<Triangle3> original_, created_;
   std::vector<Point3> samples_;
   std::vector<std::uint32_t> pending_;
+  std::uint32_t lastHit_ = 0;
   TriangleGrid originalGrid_, currentGrid_;
   OpenMesh::FPropHandleT<std::vector<std::uint32_t>> samplesOf_;
 };
