@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include <surftrack/Extract.h>
+#include <surftrack/Refine.h>
 
 namespace py = pybind11;
 using namespace surftrack;
@@ -81,7 +82,8 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
                       const std::string& adjacency, const std::string& mapping, double epsilon,
                       std::array<double, 3> spacing, std::array<double, 3> origin,
                       std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
-                      py::object progress) {
+                      py::object progress, int smoothIterations, std::optional<double> maxError,
+                      std::optional<double> reduction) {
   if (volume.ndim() != 3)
     throw py::value_error("the volume must be 3-D, not " + std::to_string(volume.ndim()) + "-D");
   const ScalarType type = scalarTypeOfDtype(volume.dtype());
@@ -135,9 +137,22 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
 
   auto r = std::make_shared<Result>();
   r->order = order;
+  std::optional<SmoothReport> smoothed;
+  std::optional<DecimateReport> decimated;
   {
     py::gil_scoped_release release;
     r->surface = extract(view, o);
+    if (smoothIterations > 0) {
+      SmoothOptions so;
+      so.iterations = smoothIterations;
+      smoothed = smooth(r->surface, so);
+    }
+    if (maxError || reduction) {
+      DecimateOptions d;
+      d.maxError = maxError;
+      d.reduction = reduction;
+      decimated = decimate(r->surface, d);
+    }
   }
   const Surface& s = r->surface;
   const py::ssize_t n = py::ssize_t(s.vertices.size()), m = py::ssize_t(s.triangles.size());
@@ -181,6 +196,23 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     if (s.seed.distance) out["seed_distance"] = *s.seed.distance;
   }
   out["warnings"] = s.warnings;
+  if (smoothed || decimated) {
+    py::dict refine;
+    if (smoothed) {
+      refine["smooth_iterations"] = smoothed->iterations;
+      refine["max_vertex_displacement"] = smoothed->maxDisplacement;
+      refine["steps_back"] = smoothed->stepsBack;
+      refine["unguarded_cubes"] = smoothed->unguardedCubes;
+      refine["volume_before"] = smoothed->volumeBefore;
+    }
+    if (decimated) {
+      refine["triangles_before"] = decimated->trianglesBefore;
+      refine["triangles_after"] = decimated->trianglesAfter;
+      if (!smoothed) refine["volume_before"] = decimated->volumeBefore;
+    }
+    refine["volume_after"] = decimated ? decimated->volumeAfter : smoothed->volumeAfter;
+    out["refine"] = refine;
+  }
   return out;
 }
 
