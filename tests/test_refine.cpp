@@ -286,3 +286,52 @@ TEST(RefineErrors, BadOptionsAndInputsThrowInvalidInput) {
   t.vertices[0][2] += 0.25;
   EXPECT_THROW(smooth(t, {}), InvalidInput);
 }
+
+#ifdef SURFTRACK_TEST_MRICRON
+#include <filesystem>
+
+#include "ReadVolume.h"
+
+namespace {
+
+/// The block [lo, lo + size) of `image`, with the geometry that keeps its voxels in place.
+template <class T>
+DenseImage<T> crop(const DenseImage<T>& image, Voxel lo, int size) {
+  DenseImage<T> out(Dims{size, size, size});
+  for (int z = 0; z < size; ++z)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) out.at(x, y, z) = image.at(lo.x + x, lo.y + y, lo.z + z);
+  out.geometry() = image.geometry();
+  out.geometry().origin = image.geometry().toPhysical({double(lo.x), double(lo.y), double(lo.z)});
+  return out;
+}
+
+}  // namespace
+
+// A 72^3 block of the Colin27 MRI (ch2better.nii.gz, 0.5 mm, mirrored frame) through the
+// cortex: every boundary at the demo's iso-value 100, linear mapping.
+TEST(RefineVolumes, MriCortexBlock) {
+  const std::string path = std::string(SURFTRACK_TEST_MRICRON) + "/ch2better.nii.gz";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
+  const auto volume = std::get<DenseImage<std::uint8_t>>(io::readVolume(path));
+  const DenseImage<std::uint8_t> block = crop(volume, {110, 150, 200}, 72);
+  const ThresholdImage<std::uint8_t> binary(block, 100.0);
+  checkSmoothThenDecimate(extractFrom(block, Selection::threshold(100), SeedRule::all()), binary, 0.25, 0.7,
+                          "MRI block");
+}
+
+// An atlas label (aal.nii.gz, label 1: the left precentral gyrus), the whole region.
+TEST(RefineVolumes, AtlasLabel) {
+  const std::string path = std::string(SURFTRACK_TEST_MRICRON) + "/aal.nii.gz";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
+  const io::AnyVolume volume = io::readVolume(path);
+  std::visit(
+      [&](const auto& image) {
+        using T = typename std::decay_t<decltype(image)>::value_type;
+        const LabelImage<T> binary(image, T(1));
+        checkSmoothThenDecimate(extractFrom(image, Selection::label(1), SeedRule::largest()), binary, 0.5, 0.8,
+                                "AAL label 1");
+      },
+      volume);
+}
+#endif
