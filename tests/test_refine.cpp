@@ -308,13 +308,13 @@ DenseImage<T> crop(const DenseImage<T>& image, Voxel lo, int size) {
 
 }  // namespace
 
-// A 72^3 block of the Colin27 MRI (ch2better.nii.gz, 0.5 mm, mirrored frame) through the
+// A 56^3 block of the Colin27 MRI (ch2better.nii.gz, 0.5 mm, mirrored frame) through the
 // cortex: every boundary at the demo's iso-value 100, linear mapping.
 TEST(RefineVolumes, MriCortexBlock) {
   const std::string path = std::string(SURFTRACK_TEST_MRICRON) + "/ch2better.nii.gz";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
   const auto volume = std::get<DenseImage<std::uint8_t>>(io::readVolume(path));
-  const DenseImage<std::uint8_t> block = crop(volume, {110, 150, 200}, 72);
+  const DenseImage<std::uint8_t> block = crop(volume, {118, 158, 208}, 56);
   const ThresholdImage<std::uint8_t> binary(block, 100.0);
   checkSmoothThenDecimate(extractFrom(block, Selection::threshold(100), SeedRule::all()), binary, 0.25, 0.7,
                           "MRI block");
