@@ -72,7 +72,9 @@ io::LoadedVolume inMemory(const io::AnyVolume& volume) {
   return loaded;
 }
 
-int extractionStages(const SurfaceOptions& o) { return o.seedMode == SeedMode::All ? 5 : 7; }
+int extractionStages(const SurfaceOptions& o) {
+  return (o.seedMode == SeedMode::All ? 5 : 7) + (o.refine.smoothIterations > 0) + o.refine.decimate();
+}
 
 namespace {
 
@@ -195,6 +197,23 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   x.surfels = surface.surfels.size();
   x.voxelBytesRead = x.mapped ? std::min<std::uintmax_t>(surface.voxelsRead * sizeOf(volume.type), x.voxelBytes)
                              : x.voxelBytes;
+  for (const ComponentFigures& c : surface.components) x.extractedVolume += c.volume;
+  int next = stage + extractionStages(o) - 1 - (o.refine.smoothIterations > 0) - o.refine.decimate();
+  if (o.refine.smoothIterations > 0) {
+    progress.stage(next++, stageCount, "smoothing");
+    SmoothOptions so;
+    so.iterations = o.refine.smoothIterations;
+    x.smooth = smooth(surface, so);
+    clock.lap(x.timings, "smooth");
+  }
+  if (o.refine.decimate()) {
+    progress.stage(next++, stageCount, "decimating");
+    DecimateOptions d;
+    d.maxError = o.refine.maxError;
+    d.reduction = o.refine.reduction;
+    x.decimate = decimate(surface, d);
+    clock.lap(x.timings, "decimate");
+  }
 
   // The files need no half-edge operation: the triangles are checked to be a closed oriented
   // 2-manifold (what building the OpenMesh mesh would check) and written from the list.

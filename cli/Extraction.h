@@ -16,6 +16,7 @@
 #include "LoadVolume.h"
 #include "ReadVolume.h"
 #include "Extract.h"
+#include "Refine.h"
 #include "SurfaceMesh.h"
 #include "VolumeView.h"
 
@@ -89,6 +90,9 @@ struct Extraction {
   // The result.
   std::vector<std::string> warnings;  ///< printed on stderr (e.g. a speck)
   std::size_t surfels = 0;
+  std::optional<SmoothReport> smooth;      ///< --smooth
+  std::optional<DecimateReport> decimate;  ///< --max-error / --reduce
+  double extractedVolume = 0;              ///< enclosed volume before smoothing and decimation
   Surface surface;  ///< the mesh written: vertices, oriented triangles, surfels
   MeshStats stats;
   std::vector<StageTiming> timings;
@@ -101,7 +105,8 @@ struct Extraction {
   std::uintmax_t bytes = 0;
 };
 
-/// The progress stages extractSurface reports: values, the core's stages, mesh.
+/// The progress stages extractSurface reports: values, the core's stages, smooth and decimate
+/// when asked, mesh.
 int extractionStages(const SurfaceOptions& options);
 
 /// Runs the pipeline on `volume` (already read; `extraction` holds the input fields and the

@@ -464,6 +464,30 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                       CLI::IsMember({"midpoint", "linear"}),
                       [](const std::string& s) { return "expected midpoint or linear, got '" + s + "'"; }))
                   ->group("surface options");
+  const std::string refine = "smoothing and decimation (after extraction)";
+  app.add_option("--smooth", o.surface.refine.smoothIterations,
+                 "Taubin lambda|mu smoothing, N iterations (default 20), every vertex\nkept on its "
+                 "surfel's segment: same voxels inside, same topology")
+      ->option_text("[N]")
+      ->expected(0, 1)
+      ->default_str("20")
+      ->check(explained(CLI::Range(1, 100000), [](const std::string& s) {
+        return "--smooth takes a number of iterations from 1 to 100000, got '" + s + "'";
+      }))
+      ->group(refine);
+  addValue(
+      app, "--max-error", "E", [&o](const std::string& s) { o.surface.refine.maxError = *toNumber(s); },
+      "decimate, keeping the surface within E (physical units) of the\nundecimated one; topology kept")
+      ->check(explained(CLI::PositiveNumber, "--max-error takes a positive distance"))
+      ->group(refine);
+  addValue(
+      app, "--reduce", "F", [&o](const std::string& s) { o.surface.refine.reduction = *toNumber(s); },
+      "decimate, removing the fraction F in [0, 1) of the triangles (as far as\n--max-error and "
+      "the topology allow)")
+      ->check(explained(CLI::Range(0.0, 0.999999), [](const std::string& s) {
+        return "--reduce takes a fraction in [0, 1), got '" + s + "'";
+      }))
+      ->group(refine);
 
   a.input = addInputOptions(app, o.input);
   addOutputOptions(app, o.out);

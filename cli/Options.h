@@ -38,6 +38,14 @@ struct InputOptions {
 enum class SeedMode { Largest, All, Voxel, Ray, Surfel, Point };
 enum class MappingMode { Default, Midpoint, Linear };
 
+/// Post-processing of the surface (docs/cli.md, "Smoothing and decimation").
+struct RefineOptions {
+  int smoothIterations = 0;             ///< --smooth [N] (20 without N); 0: no smoothing
+  std::optional<double> maxError;       ///< --max-error E: decimate within E (physical units)
+  std::optional<double> reduction;      ///< --reduce F: decimate F of the triangles away
+  bool decimate() const { return maxError || reduction; }
+};
+
 /// What surface to extract: a threshold or a label, a seed rule, a pair, a mapping.
 struct SurfaceOptions {
   std::optional<double> iso;     ///< --iso S: 1-voxels are f > S
@@ -49,6 +57,7 @@ struct SurfaceOptions {
   AdjacencyPair pair = AdjacencyPair::k26_6;
   MappingMode mapping = MappingMode::Default;
   int threads = 0;               ///< --threads N (0: all cores)
+  RefineOptions refine;          ///< --smooth, --max-error, --reduce
 };
 
 struct OutputOptions {

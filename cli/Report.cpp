@@ -229,6 +229,26 @@ void printSummary(std::ostream& out, const Extraction& x) {
     s << (m.closed && m.manifold ? "; closed 2-manifold" : m.closed ? "; closed, NOT a manifold" : "; NOT closed");
     row(out, "topology", s.str());
   }
+  double volume = 0;
+  for (const auto& c : m.components) volume += c.volume;
+  auto change = [&](double before) {
+    return before != 0 ? num(100.0 * (volume - before) / std::abs(before), 3) + " %" : std::string("n/a");
+  };
+  if (x.smooth) {
+    std::ostringstream s;
+    s << x.smooth->iterations << " Taubin iterations on the surfels' segments; largest vertex move "
+      << num(x.smooth->maxDisplacement, 4) << "; " << x.smooth->stepsBack << " moves stepped back by the fold check";
+    if (x.smooth->unguardedCubes) s << "; " << x.smooth->unguardedCubes << " cubes folded already (unchecked)";
+    row(out, "smoothing", s.str());
+  }
+  if (x.decimate) {
+    std::ostringstream s;
+    s << x.decimate->trianglesBefore << " -> " << x.decimate->trianglesAfter << " triangles";
+    if (x.decimate->targetTriangles) s << " (target " << x.decimate->targetTriangles << ")";
+    row(out, "decimation", s.str());
+  }
+  if (x.smooth || x.decimate)
+    row(out, "volume", num(volume, 8) + " (physical), " + change(x.extractedVolume) + " from the extracted surface");
   row(out, "bbox", tripleText(m.min) + " .. " + tripleText(m.max) + " (physical)");
   if (!x.output.empty()) {
     std::string fmt = x.format;
@@ -312,6 +332,31 @@ json extractionJson(const Extraction& x) {
     components.push_back(std::move(component));
   }
   j["component_list"] = std::move(components);
+  if (x.smooth || x.decimate) {
+    double volume = 0;
+    for (const auto& c : m.components) volume += c.volume;
+    json refine;
+    refine["extracted_volume"] = number(x.extractedVolume);
+    refine["volume"] = number(volume);
+    refine["volume_change"] = x.extractedVolume != 0 ? number((volume - x.extractedVolume) / std::abs(x.extractedVolume)) : json();
+    if (x.smooth) {
+      json s;
+      s["iterations"] = x.smooth->iterations;
+      s["max_vertex_displacement"] = number(x.smooth->maxDisplacement);
+      s["steps_back"] = x.smooth->stepsBack;
+      s["cubes"] = x.smooth->cubes;
+      s["unguarded_cubes"] = x.smooth->unguardedCubes;
+      refine["smoothing"] = std::move(s);
+    }
+    if (x.decimate) {
+      json d;
+      d["triangles_before"] = x.decimate->trianglesBefore;
+      d["triangles_after"] = x.decimate->trianglesAfter;
+      if (x.decimate->targetTriangles) d["target_triangles"] = x.decimate->targetTriangles;
+      refine["decimation"] = std::move(d);
+    }
+    j["refine"] = std::move(refine);
+  }
   if (m.components.size() > kListed) j["component_list_truncated_to"] = kListed;
   if (!x.output.empty()) {
     json output;

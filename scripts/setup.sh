@@ -6,7 +6,8 @@ set -euo pipefail
 packages=(
   build-essential cmake          # compiler and build system
   libboost-graph-dev             # Boost.Graph: the surface graph, voxel components in tests
-  libopenmesh-dev                # OpenMesh: half-edge meshes and mesh IO
+  libopenmesh-dev                # OpenMesh: half-edge meshes and mesh IO, the Decimater (refine/)
+  libcgal-dev                    # CGAL 5.5, header-only: the refine tests' independent checks (self-intersection, point-in-mesh, distance); never linked into the engine
   libgtest-dev                   # GoogleTest
   libinsighttoolkit5-dev         # ITK: NIfTI / NRRD / MetaImage / DICOM volumes for the CLI
   libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip size checks)

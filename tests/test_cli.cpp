@@ -424,6 +424,48 @@ TEST_F(Cli, EulerCharacteristicAndGenus) {
   EXPECT_NE(r.out.find("Euler characteristic -2 in total; by genus: 1 x1 2 x1"), std::string::npos) << r.out;
 }
 
+TEST_F(Cli, SmoothingAndDecimationKeepTheTopology) {
+  // The two rings of EulerCharacteristicAndGenus (genus 1 and 2), smoothed and decimated.
+  DenseImage<std::uint8_t> image(Dims{30, 12, 8}, 0);
+  for (int z = 2; z <= 5; ++z)
+    for (int y = 2; y <= 9; ++y) {
+      for (int x = 2; x <= 9; ++x)
+        if (!(x >= 4 && x <= 7 && y >= 4 && y <= 7)) image.at(x, y, z) = 1;
+      for (int x = 14; x <= 27; ++x)
+        if (!(y >= 4 && y <= 7 && ((x >= 16 && x <= 19) || (x >= 22 && x <= 25)))) image.at(x, y, z) = 1;
+    }
+  io::writeVolume(io::AnyVolume(image), path("rings.mha"));
+  RunResult plain = run({"mesh", path("rings.mha"), "-o", path("plain.ply"), "--iso", "0.5", "--all", "--json"});
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  RunResult r = run({"mesh", path("rings.mha"), "--smooth", "-o", path("light.ply"), "--iso", "0.5", "--all",
+                     "--max-error", "0.5", "--reduce", "0.6", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(jsonNumber(r.out, "euler_characteristic"), -2.0);
+  EXPECT_EQ(jsonNumber(r.out, "components"), 2.0);
+  EXPECT_EQ(jsonNumber(r.out, "iterations"), 20.0);  // --smooth without N
+  EXPECT_GT(jsonNumber(r.out, "max_vertex_displacement"), 0.0);
+  EXPECT_LT(jsonNumber(r.out, "triangles_after"), jsonNumber(r.out, "triangles_before"));
+  EXPECT_EQ(jsonNumber(r.out, "triangles_before"), jsonNumber(plain.out, "triangles"));
+  EXPECT_LT(jsonNumber(r.out, "triangles"), jsonNumber(plain.out, "triangles"));
+  // (Walls two voxels thick lose their corners to smoothing: the change is reported, not bounded.)
+  EXPECT_NEAR(jsonNumber(r.out, "volume_change"),
+              jsonNumber(r.out, "volume") / jsonNumber(r.out, "extracted_volume") - 1, 1e-6);
+  EXPECT_GT(jsonNumber(r.out, "extracted_volume"), 0.0);
+  r = run({"mesh", path("rings.mha"), "-o", path("smooth.ply"), "--iso", "0.5", "--all", "--smooth", "5"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* line : {"smoothing   5 Taubin iterations", "volume ", "Euler characteristic -2 in total"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  for (const auto& bad : std::vector<std::vector<std::string>>{
+           {"--reduce", "1.5"}, {"--reduce", "-0.1"}, {"--max-error", "0"}, {"--max-error", "x"}, {"--smooth", "0"}}) {
+    std::vector<std::string> args{"mesh", path("rings.mha"), "-o", path("bad.ply"), "--iso", "0.5"};
+    args.insert(args.end(), bad.begin(), bad.end());
+    r = run(args);
+    EXPECT_EQ(r.code, 2) << bad[0] << " " << bad[1];
+    EXPECT_NE(r.err.find(bad[0]), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
 // --- output for people and scripts ----------------------------------------------------------
 
 TEST_F(Cli, SummaryJsonAndQuiet) {

@@ -211,6 +211,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   Stages stages(o, scanning ? 3 : 5, out);  // (the last, "figures", is empty without figures)
   const SourceImage binary(source, o.selection);
   const ImageGeometry geometry = source.geometry();
+  out.geometry = geometry;
   TriangleMesh mesh;
   if (scanning) {
     stages.begin("scan");

@@ -8,6 +8,7 @@
 
 #include <surftrack/Extract.h>
 #include <surftrack/Labels.h>
+#include <surftrack/Refine.h>
 
 namespace py = pybind11;
 using namespace surftrack;
@@ -142,7 +143,8 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
                       const std::string& adjacency, const std::string& mapping, double epsilon,
                       std::array<double, 3> spacing, std::array<double, 3> origin,
                       std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
-                      py::object progress) {
+                      py::object progress, int smoothIterations, std::optional<double> maxError,
+                      std::optional<double> reduction) {
   const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
   ExtractOptions o;
   o.selection = selectionKind == "label" ? Selection::label(value) : Selection::threshold(value);
@@ -178,9 +180,22 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
 
   auto r = std::make_shared<Result>();
   r->order = order;
+  std::optional<SmoothReport> smoothed;
+  std::optional<DecimateReport> decimated;
   {
     py::gil_scoped_release release;
     r->surface = extract(view, o);
+    if (smoothIterations > 0) {
+      SmoothOptions so;
+      so.iterations = smoothIterations;
+      smoothed = smooth(r->surface, so);
+    }
+    if (maxError || reduction) {
+      DecimateOptions d;
+      d.maxError = maxError;
+      d.reduction = reduction;
+      decimated = decimate(r->surface, d);
+    }
   }
   py::dict out = surfaceDict(r);
   const Surface& s = r->surface;
@@ -196,6 +211,23 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     if (s.seed.distance) out["seed_distance"] = *s.seed.distance;
   }
   out["warnings"] = s.warnings;
+  if (smoothed || decimated) {
+    py::dict refine;
+    if (smoothed) {
+      refine["smooth_iterations"] = smoothed->iterations;
+      refine["max_vertex_displacement"] = smoothed->maxDisplacement;
+      refine["steps_back"] = smoothed->stepsBack;
+      refine["unguarded_cubes"] = smoothed->unguardedCubes;
+      refine["volume_before"] = smoothed->volumeBefore;
+    }
+    if (decimated) {
+      refine["triangles_before"] = decimated->trianglesBefore;
+      refine["triangles_after"] = decimated->trianglesAfter;
+      if (!smoothed) refine["volume_before"] = decimated->volumeBefore;
+    }
+    refine["volume_after"] = decimated ? decimated->volumeAfter : smoothed->volumeAfter;
+    out["refine"] = refine;
+  }
   return out;
 }
 

@@ -39,11 +39,15 @@ class Surface:
     warnings  things to know, e.g. that a seeded surface is a speck (also issued as Python
               warnings)
     voxels    label_surfaces: the voxels of the label
+    refine    with smooth / max_error / reduce: the figures of smoothing and decimation
+              (smooth_iterations, max_vertex_displacement, steps_back, unguarded_cubes,
+              triangles_before, triangles_after, volume_before, volume_after)
     """
 
     def __init__(self, vertices, faces, result=None, normals=None, surfels=None, components=(),
                  euler=0, boundaries_in_image=0, mapping="midpoint", timings=None,
-                 seed_surfel=None, seed_walk_steps=0, seed_distance=None, warnings=(), voxels=None):
+                 seed_surfel=None, seed_walk_steps=0, seed_distance=None, warnings=(), voxels=None,
+                 refine=None):
         self.vertices = vertices
         self.faces = faces
         self._result = result
@@ -59,6 +63,7 @@ class Surface:
         self.seed_distance = seed_distance
         self.warnings = list(warnings)
         self.voxels = voxels
+        self.refine = dict(refine or {})
 
     @property
     def normals(self) -> np.ndarray:
@@ -158,7 +163,9 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
             mapping: str = "default",
             spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, affine=None,
             epsilon: float = 1e-3, threads: int = 0, figures: bool = True,
-            progress: Optional[Callable[[str, int, int, int], None]] = None) -> Surface:
+            progress: Optional[Callable[[str, int, int, int], None]] = None,
+            smooth: int = 0, max_error: Optional[float] = None,
+            reduce: Optional[float] = None) -> Surface:
     """The surface of one boundary (mode="seed"), of the largest, or of all boundaries.
 
     The selected voxels are ``volume > level`` or ``volume == label``. ``seed`` is a voxel index
@@ -171,8 +178,11 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     is called at each stage and while tracking. ``threads`` (0: all cores) runs the scan of
     "largest" and "all" in parallel; the surface is the same for any number. ``figures=False``
     skips the per-component figures (``components`` empty, ``euler`` 0). ``affine`` (a 4x4 voxel-to-world matrix, as
-    nibabel's ``img.affine``) replaces spacing, origin and direction. Raises ValueError /
-    TypeError on bad input.
+    nibabel's ``img.affine``) replaces spacing, origin and direction. ``smooth=N`` smooths
+    with N Taubin iterations, every vertex kept on its surfel's segment (the same voxels
+    inside, the same topology); ``max_error`` (physical units) and/or ``reduce`` (the fraction
+    of triangles to remove) then decimate without changing the topology (docs/python.md).
+    Raises ValueError / TypeError on bad input.
     """
     array = _as_volume(volume)
     if affine is not None:
@@ -182,6 +192,8 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
             level = (float(np.nanmin(array)) + float(np.nanmax(array))) / 2.0
         else:
             raise ValueError("give either level or label, not both")
+    if int(smooth) != smooth or smooth < 0:
+        raise ValueError(f"smooth takes a number of iterations >= 0, not {smooth!r}")
     if mode not in ("seed", "largest", "all"):
         raise ValueError(f"unknown mode '{mode}': expected 'seed', 'largest' or 'all'")
     if adjacency not in _ADJACENCIES:
@@ -230,7 +242,9 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
         out = _surftrack.extract_array(array, order, kind, value, seed_kind, seed_values,
                                        adjacency, mapping, float(epsilon), spacing, origin,
                                        direction.tolist(), int(threads), bool(figures),
-                                       progress)
+                                       progress, int(smooth),
+                                       None if max_error is None else float(max_error),
+                                       None if reduce is None else float(reduce))
     except ValueError as error:
         note = _range_note(array, value) if kind == "threshold" else ""
         raise ValueError(f"{error}{note}") from None

@@ -135,6 +135,9 @@ struct Surface {
   AdjacencyPair pair = AdjacencyPair::k26_6;
   Selection selection;
   Mapping mapping = Mapping::Midpoint;  ///< the mapping used (never Default)
+  /// The source's geometry: a surfel's segment ]c, d[ is [toPhysical(c), toPhysical(d)] in
+  /// physical space (smooth() keeps every vertex on it).
+  ImageGeometry geometry;
   std::vector<StageTime> timings;
   /// Voxels the extraction asked of the source: its bricks (apron included), rows and gray
   /// values. What a lazy source (a memory-mapped file) has to read; a seeded extraction keeps

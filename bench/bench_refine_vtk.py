@@ -1,0 +1,162 @@
+#!/usr/bin/python3
+"""Smoothing and decimation, surftrack against VTK, in one run (docs/performance.md,
+"Smoothing and decimation").
+
+Runs bench_refine (the binary clean sphere of Figure 9, R = 0.4 q: its midpoint mesh, smooth()
+and decimate()), then VTK on the same midpoint mesh: vtkWindowedSincPolyDataFilter with the same
+number of iterations, and vtkQuadricDecimation with the same reduction. Reports for each result
+the RMS of |x - c| - R over the vertices, the enclosed volume against the midpoint mesh's, the
+times, and, from surftrack_mesh_check (CGAL, tests/mesh_check.cpp), closedness, genus and
+self-intersecting triangle pairs. Renders a before/after PNG with gnuplot.
+
+Needs Debian's /usr/bin/python3 with numpy and vtk 9 (python3-vtk9).
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+
+
+def read_ply(path):
+    r = vtk.vtkPLYReader()
+    r.SetFileName(path)
+    r.Update()
+    out = vtk.vtkPolyData()
+    out.DeepCopy(r.GetOutput())
+    return out
+
+
+def write_ply(poly, path):
+    w = vtk.vtkPLYWriter()
+    w.SetFileName(path)
+    w.SetInputData(poly)
+    w.SetFileTypeToBinary()
+    w.Write()
+
+
+def figures(poly, centre, radius):
+    p = vtk_to_numpy(poly.GetPoints().GetData()).astype(float)
+    r = np.linalg.norm(p - centre, axis=1)
+    mass = vtk.vtkMassProperties()
+    mass.SetInputData(poly)
+    mass.Update()
+    return {"triangles": poly.GetNumberOfPolys(), "rms": float(np.sqrt(np.mean((r - radius) ** 2))),
+            "volume": mass.GetVolume()}
+
+
+def check(tool, path):
+    return json.loads(subprocess.run([tool, path], check=True, capture_output=True, text=True).stdout)
+
+
+def render(meshes, titles, path, centre, radius):
+    """Side-by-side close-ups (gnuplot, pngcairo) of the cap x > c + 0.8 R of each mesh: its
+    triangles as lit polygons, so the terraces of the midpoint mesh show."""
+    data = []
+    for i, poly in enumerate(meshes):
+        p = vtk_to_numpy(poly.GetPoints().GetData()).astype(float) - centre
+        cells = vtk_to_numpy(poly.GetPolys().GetData()).reshape(-1, 4)[:, 1:]
+        keep = (p[cells][:, :, 0] > 0.8 * radius).all(axis=1)
+        name = f"{path}.{i}.dat"
+        with open(name, "w") as f:
+            for t in cells[keep]:
+                for v in t:
+                    f.write(f"{p[v][1]:.5f} {p[v][2]:.5f} {p[v][0]:.5f}\n")
+                f.write("\n")
+        data.append(name)
+    script = [f"set terminal pngcairo size {420 * len(meshes)},460", f"set output '{path}'",
+              f"set multiplot layout 1,{len(meshes)}", "unset key", "unset tics", "unset border",
+              "set view 20,20,1.3", "set pm3d depthorder lighting primary 0.6 specular 0.2",
+              "set style fill solid 1.0 border lc rgb '#555555'", "set view equal xyz"]
+    for name, title in zip(data, titles):
+        script += [f"set title '{title}'", f"splot '{name}' with polygons fc rgb '#d9c09a'"]
+    script.append("unset multiplot")
+    subprocess.run(["gnuplot"], input="\n".join(script), text=True, check=True)
+    for name in data:
+        os.remove(name)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default="build", help="the CMake build directory (default: build)")
+    ap.add_argument("--size", type=int, default=128, help="the sphere's image side q (default 128)")
+    ap.add_argument("--iterations", type=int, default=50, help="smoothing iterations, both tools (default 50)")
+    ap.add_argument("--max-error", type=float, default=0.5, help="surftrack's decimation bound, voxels (default 0.5)")
+    ap.add_argument("--reduce", type=float, default=0.9, help="fraction of triangles removed, both tools (default 0.9)")
+    ap.add_argument("--passband", type=float, default=0.1, help="vtkWindowedSincPolyDataFilter pass band (default 0.1)")
+    ap.add_argument("--out", default="bench-refine", help="directory for the meshes (default bench-refine)")
+    ap.add_argument("--png", help="write the before/after picture here")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    bench = os.path.join(a.build, "bench", "bench_refine")
+    tool = os.path.join(a.build, "tests", "surftrack_mesh_check")
+    ours = json.loads(subprocess.run([bench, "--size", str(a.size), "--iterations", str(a.iterations),
+                                      "--max-error", str(a.max_error), "--reduce", str(a.reduce), "--out", a.out],
+                                     check=True, capture_output=True, text=True).stdout)
+    centre, radius = np.full(3, ours["centre"]), ours["radius"]
+    midpoint = read_ply(os.path.join(a.out, "sphere-midpoint.ply"))
+
+    sinc = vtk.vtkWindowedSincPolyDataFilter()
+    sinc.SetInputData(midpoint)
+    sinc.SetNumberOfIterations(a.iterations)
+    sinc.SetPassBand(a.passband)
+    sinc.BoundarySmoothingOff()
+    sinc.FeatureEdgeSmoothingOff()
+    sinc.NonManifoldSmoothingOn()
+    sinc.NormalizeCoordinatesOn()
+    t0 = time.perf_counter()
+    sinc.Update()
+    sinc_s = time.perf_counter() - t0
+    smoothed = sinc.GetOutput()
+    write_ply(smoothed, os.path.join(a.out, "vtk-sinc.ply"))
+
+    decimation = vtk.vtkQuadricDecimation()
+    decimation.SetInputData(smoothed)
+    decimation.SetTargetReduction(a.reduce)
+    t0 = time.perf_counter()
+    decimation.Update()
+    quadric_s = time.perf_counter() - t0
+    decimated = decimation.GetOutput()
+    write_ply(decimated, os.path.join(a.out, "vtk-quadric.ply"))
+
+    base = figures(midpoint, centre, radius)
+    rows = []
+    for name, path, secs in [
+            ("midpoint mesh", "sphere-midpoint.ply", None),
+            ("surftrack smooth()", "sphere-smoothed.ply", ours["smooth_s"]["wall"]),
+            ("VTK windowed sinc", "vtk-sinc.ply", sinc_s),
+            ("surftrack decimate()", "sphere-decimated.ply", ours["decimate_s"]["wall"]),
+            ("VTK quadric decimation", "vtk-quadric.ply", quadric_s)]:
+        poly = read_ply(os.path.join(a.out, path))
+        f = figures(poly, centre, radius)
+        c = check(tool, os.path.join(a.out, path))
+        rows.append({"result": name, "triangles": f["triangles"], "rms": f["rms"],
+                     "rms_drop": base["rms"] / f["rms"] if f["rms"] > 0 else None,
+                     "volume_change_pct": 100 * (f["volume"] - base["volume"]) / base["volume"],
+                     "seconds": secs, "genus": c["genus"], "closed_manifold": c["closed_oriented"] and c["manifold"],
+                     "self_intersecting_pairs": c["self_intersecting_pairs"]})
+    print(f"binary clean sphere q = {a.size}, R = {radius:g}; {a.iterations} iterations; reduce {a.reduce}; "
+          f"surftrack max error {a.max_error}; load average {os.getloadavg()[0]:.2f}")
+    print(f"{'result':24s} {'triangles':>9s} {'RMS':>8s} {'drop':>6s} {'volume':>9s} {'time s':>7s} "
+          f"{'genus':>6s} {'manifold':>8s} {'self-int':>8s}")
+    for r in rows:
+        secs = "" if r["seconds"] is None else f"{r['seconds']:.3f}"
+        drop = "" if r["rms_drop"] is None else f"{r['rms_drop']:.2f}x"
+        print(f"{r['result']:24s} {r['triangles']:9d} {r['rms']:8.4f} {drop:>6s} {r['volume_change_pct']:+8.3f}% "
+              f"{secs:>7s} {str(r['genus']):>6s} {str(r['closed_manifold']):>8s} {r['self_intersecting_pairs']:8d}")
+    if a.png:
+        render([read_ply(os.path.join(a.out, p)) for p in ("sphere-midpoint.ply", "sphere-smoothed.ply",
+                                                            "vtk-sinc.ply", "sphere-decimated.ply")],
+               ["midpoint (terraced)", "surftrack smooth()", "VTK windowed sinc", "surftrack decimate()"], a.png,
+               centre, radius)
+        print("picture:", a.png)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

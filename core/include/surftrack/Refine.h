@@ -1,0 +1,65 @@
+// Post-processing of an extracted Surface (docs/api.md, "Smoothing and decimation"): smoothing
+// that keeps every vertex on its surfel's segment, and decimation that never changes the
+// topology. Both keep a Surface closed, oriented and manifold, with the same components and
+// Euler characteristic; docs/theory.md, sections 8 and 10, says why.
+//
+//   surftrack::Surface s = surftrack::extract(view, options);
+//   surftrack::smooth(s, {});                               // 10 Taubin lambda|mu iterations
+//   surftrack::DecimateOptions d;  d.maxError = 0.5;  d.reduction = 0.9;
+//   surftrack::decimate(s, d);
+#pragma once
+
+#include <cstddef>
+#include <optional>
+
+#include "Extract.h"
+
+namespace surftrack {
+
+struct SmoothOptions {
+  int iterations = 20;    ///< Taubin lambda|mu pairs of passes (0: nothing moves)
+  double lambda = 0.7;    ///< the strength: the shrinking pass's factor, in ]0, 1]
+  double mu = -0.73;      ///< the inflating pass's factor, mu < -lambda, mu >= -1
+  double epsilon = 1e-3;  ///< each vertex stays at t in [epsilon, 1 - epsilon] of its segment
+};
+
+struct SmoothReport {
+  int iterations = 0;
+  std::size_t cubes = 0;           ///< digital 3-cubes holding triangles
+  std::size_t unguardedCubes = 0;  ///< cubes not embedded before smoothing (left unchecked)
+  std::size_t stepsBack = 0;       ///< vertex moves halved or undone by the fold check
+  double maxDisplacement = 0;      ///< physical units
+  double volumeBefore = 0, volumeAfter = 0;  ///< signed enclosed volume, physical units^3
+};
+
+struct DecimateOptions {
+  /// Largest distance (physical units) of a removed vertex to the decimated surface.
+  std::optional<double> maxError;
+  /// Fraction of the triangles to remove, in [0, 1[ (as VTK's TargetReduction).
+  std::optional<double> reduction;
+  double maxNormalDeviation = 60;  ///< degrees: no triangle normal turns more
+};
+
+struct DecimateReport {
+  std::size_t trianglesBefore = 0, trianglesAfter = 0;
+  std::size_t targetTriangles = 0;  ///< (1 - reduction) * trianglesBefore; 0 without a reduction
+  double volumeBefore = 0, volumeAfter = 0;
+};
+
+/// Smooths `surface` in place: Taubin lambda|mu smoothing in physical space with every vertex
+/// kept on its surfel's segment ]c, d[ (at t in [epsilon, 1 - epsilon], mapped through
+/// surface.geometry) and a fold check per digital 3-cube. Vertices, triangles and surfels keep
+/// their indices; the figures are recomputed.
+/// \pre surface is as extract() returns it (not decimated).
+/// \throw InvalidInput for options out of range, or a surface that is not a continuous analog
+///        (a decimated one, or vertices moved off their segments).
+SmoothReport smooth(Surface& surface, const SmoothOptions& options = {});
+
+/// Decimates `surface` in place by halfedge collapses (OpenMesh's Decimater) under the link
+/// condition, a normal-flip guard and the error bound, up to the reduction if one is given.
+/// Surviving vertices keep their points and surfels; vertex indices are renumbered. The figures
+/// are recomputed.
+/// \throw InvalidInput for options out of range, or neither a maxError nor a reduction.
+DecimateReport decimate(Surface& surface, const DecimateOptions& options);
+
+}  // namespace surftrack

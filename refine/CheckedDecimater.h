@@ -1,0 +1,38 @@
+// A greedy decimater over OpenMesh's Decimater modules that checks every collapse at the moment
+// it is performed (docs/theory.md, section 10). OpenMesh's own DecimaterT evaluates a candidate
+// when it enters the heap and collapses it later without asking the modules again, so a
+// constraint that depends on more than the candidate's one-ring (the embedding guard, the
+// Hausdorff bound after nearby collapses) may no longer hold. Here a candidate popped from the
+// heap whose vertex has changed since it was evaluated is dropped (it was pushed again, with its
+// new priority, when the vertex changed); one that has not is asked of every module and
+// collapsed only if all allow it.
+#pragma once
+
+#include <cstddef>
+
+#include <OpenMesh/Tools/Decimater/BaseDecimaterT.hh>
+
+namespace surftrack::refine {
+
+template <class MeshT>
+class CheckedDecimaterT : public OpenMesh::Decimater::BaseDecimaterT<MeshT> {
+ public:
+  using Base = OpenMesh::Decimater::BaseDecimaterT<MeshT>;
+  using CollapseInfo = typename Base::CollapseInfo;
+  explicit CheckedDecimaterT(MeshT& mesh) : Base(mesh), mesh_(mesh) {}
+
+  /// Collapses the best legal halfedges (lowest priority first) until at most `faces`
+  /// triangles remain or no collapse is legal. A candidate enters the heap with
+  /// `priority(ci)` (the priority module alone, cheap; ILLEGAL_COLLAPSE keeps it out) and is
+  /// asked of every module when it comes out. Returns the number of collapses.
+  /// \pre initialize() succeeded; the mesh has vertex, halfedge, edge and face status.
+  template <class Priority>
+  std::size_t decimateToFaces(std::size_t faces, Priority&& priority);
+
+ private:
+  MeshT& mesh_;
+};
+
+}  // namespace surftrack::refine
+
+#include "CheckedDecimater_impl.h"

@@ -1,0 +1,41 @@
+// Constrained smoothing of a continuous analog (docs/theory.md, section 8, "Smoothing inside
+// the segments"): Taubin's lambda|mu smoothing, in physical space, of a mesh whose every vertex
+// stays on its own surfel's segment ]c, d[ (paper §3.1), at a parameter t in
+// [epsilon, 1 - epsilon], with a fold check per digital 3-cube and a step back where a cube
+// would fold. The connectivity is not touched, so the topology is the input's; every voxel
+// centre keeps its side (section 8), and no cube that was embedded stops being so.
+#pragma once
+
+#include <cstddef>
+
+#include "Geometry.h"
+#include "SurfaceMesh.h"
+
+namespace surftrack::refine {
+
+struct SmoothingParameters {
+  int iterations = 20;    ///< lambda|mu pairs of passes
+  double lambda = 0.7;    ///< the shrinking pass's factor, in ]0, 1]
+  double mu = -0.73;      ///< the inflating pass's factor, with mu < -lambda < 0
+  double epsilon = 1e-3;  ///< t stays in [epsilon, 1 - epsilon], epsilon in ]0, 0.5[
+  int halvings = 4;       ///< step-back halvings of a vertex's move before it stays put
+};
+
+struct SmoothingReport {
+  int passes = 0;                  ///< 2 * iterations
+  std::size_t cubes = 0;           ///< digital 3-cubes holding triangles
+  std::size_t unguardedCubes = 0;  ///< cubes not embedded in the input, left unchecked
+  std::size_t stepsBack = 0;       ///< vertex moves halved or undone by the fold check
+  double maxDisplacement = 0;      ///< largest vertex move, physical units
+};
+
+/// Smooths `mesh` in place. Its points are physical (`geometry` applied to index space), every
+/// vertex carries its surfel (kSurfelPropertyName) and lies on that surfel's segment.
+/// \pre mesh is a continuous analog as the converter builds it: every triangle's vertices lie on
+///      edges of one digital 3-cube.
+/// \throw std::invalid_argument for parameters out of range, a vertex off its segment, or a
+///        triangle whose vertices lie in no single cube (e.g. a decimated mesh).
+SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometry,
+                                 const SmoothingParameters& parameters = {});
+
+}  // namespace surftrack::refine

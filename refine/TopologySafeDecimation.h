@@ -1,0 +1,40 @@
+// Topology-safe decimation of a closed surface mesh with OpenMesh's Decimater (docs/theory.md,
+// section 10): halfedge collapses ordered by the quadric error (Garland & Heckbert), each one
+// allowed only if it
+//  - keeps the topology (ModTopologyGuardT: the link condition),
+//  - keeps the mesh embedded (ModEmbeddingGuardT: no new triangle meets another one),
+//  - keeps the surface within `maxError` of the original one both ways, on samples
+//    (ModSampledDistanceT), and the quadric error below maxError^2 (ModQuadricT),
+//  - turns no triangle normal by more than `maxNormalDeviation` degrees (ModNormalFlippingT).
+// A halfedge collapse moves no vertex: the survivors keep their points and their surfels.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+
+#include "SurfaceMesh.h"
+
+namespace surftrack::refine {
+
+struct DecimationParameters {
+  /// Largest distance, in the mesh's (physical) units, between the decimated and the original
+  /// surface, both ways, on samples (DistanceGuard.h); nothing: no bound.
+  std::optional<double> maxError;
+  /// Fraction of the triangles to remove, in [0, 1[ (VTK's TargetReduction); nothing: as many
+  /// as the other bounds allow.
+  std::optional<double> targetReduction;
+  double maxNormalDeviation = 60;  ///< degrees, in ]0, 180]
+};
+
+struct DecimationReport {
+  std::size_t trianglesBefore = 0, trianglesAfter = 0;
+  std::size_t verticesBefore = 0, verticesAfter = 0;
+  std::size_t targetTriangles = 0;  ///< what targetReduction asked for (0: no target)
+};
+
+/// Decimates `mesh` in place (a closed 2-manifold; vertex properties such as the surfels follow
+/// the surviving vertices), then collects the garbage.
+/// \throw std::invalid_argument for parameters out of range or a mesh with a boundary.
+DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& parameters);
+
+}  // namespace surftrack::refine

@@ -1,0 +1,337 @@
+// Constrained smoothing and topology-safe decimation (refine/, docs/theory.md sections 8 and
+// 10, docs/api.md): after each, checked independently of the code under test (CgalMeshChecks.h:
+// combinatorics by hand, geometry with CGAL): a closed oriented manifold with the Euler
+// characteristic and components of the input, no self-intersection; smoothing keeps every vertex
+// on its segment and every voxel centre on its side (CGAL point-in-mesh against the image itself);
+// decimation stays within its error (sampled, both ways) and meets its triangle target.
+#include <gtest/gtest.h>
+#include <surftrack/Extract.h>
+#include <surftrack/Refine.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "Image.h"
+#include "CgalMeshChecks.h"
+#include "PairTestName.h"
+#include "Phantoms.h"
+
+using namespace surftrack;
+namespace ck = surftrack::checks;
+
+namespace {
+
+/// Everything a test compares before and after.
+struct Shape {
+  ck::Topology topology;
+  std::size_t selfIntersections = 0;
+};
+
+Shape shapeOf(const Surface& s) {
+  Shape out;
+  out.topology = ck::topologyOf(s.vertices.size(), s.triangles);
+  out.selfIntersections = ck::selfIntersections(ck::cgalMesh(s.vertices, s.triangles));
+  return out;
+}
+
+/// A closed oriented manifold with the topology of `before` and no self-intersection.
+void expectSameTopology(const Shape& before, const Surface& after, const std::string& what) {
+  const Shape s = shapeOf(after);
+  EXPECT_TRUE(s.topology.closedOriented) << what << ": " << s.topology.problem;
+  EXPECT_TRUE(s.topology.manifoldVertices) << what << ": " << s.topology.problem;
+  EXPECT_EQ(s.topology.euler, before.topology.euler) << what;
+  EXPECT_EQ(s.topology.components, before.topology.components) << what;
+  EXPECT_EQ(s.selfIntersections, 0u) << what;
+}
+
+/// Every vertex on its surfel's segment, at t in [epsilon, 1 - epsilon] (geometry inverted here).
+void expectOnSegments(const Surface& s, double epsilon, const std::string& what) {
+  std::size_t off = 0;
+  for (std::size_t v = 0; v < s.vertices.size(); ++v) {
+    const auto p = s.geometry.toIndex(s.vertices[v]);
+    const Voxel c = s.surfels[v].inside(), d = s.surfels[v].outside();
+    int axis = 0;
+    while (c[axis] == d[axis]) ++axis;
+    const double t = (p[axis] - c[axis]) / double(d[axis] - c[axis]);
+    bool ok = t >= epsilon - 1e-9 && t <= 1 - epsilon + 1e-9;
+    for (int k = 0; k < 3; ++k)
+      if (k != axis && std::abs(p[k] - c[k]) > 1e-9) ok = false;
+    if (!ok && ++off <= 3) ADD_FAILURE() << what << ": vertex " << v << " is off its segment (t = " << t << ")";
+  }
+}
+
+/// Every voxel centre of [lo, hi]^3 (index space) is inside the mesh exactly when it is a
+/// 1-voxel of `image` (CGAL's ray-parity point-in-mesh).
+template <class BinaryImage>
+void expectVoxelSides(const Surface& s, const BinaryImage& image, Voxel lo, Voxel hi, const std::string& what) {
+  const ck::CgalMesh mesh = ck::cgalMesh(s.vertices, s.triangles);
+  CGAL::Side_of_triangle_mesh<ck::CgalMesh, ck::Kernel> side(mesh);
+  std::size_t wrong = 0;
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x; ++x) {
+        const auto p = s.geometry.toPhysical({double(x), double(y), double(z)});
+        const auto where = side(ck::Kernel::Point_3(p[0], p[1], p[2]));
+        const bool inside = where == CGAL::ON_BOUNDED_SIDE;
+        if (where == CGAL::ON_BOUNDARY || inside != bool(image(x, y, z)))
+          if (++wrong <= 3) ADD_FAILURE() << what << ": voxel (" << x << "," << y << "," << z << ") is on the wrong side";
+      }
+}
+
+/// The voxel centres within one voxel of a surfel: those whose side could change.
+template <class BinaryImage>
+void expectVoxelSidesNearSurface(const Surface& s, const BinaryImage& image, const std::string& what) {
+  const ck::CgalMesh mesh = ck::cgalMesh(s.vertices, s.triangles);
+  CGAL::Side_of_triangle_mesh<ck::CgalMesh, ck::Kernel> side(mesh);
+  std::size_t wrong = 0, checked = 0;
+  for (const Surfel& sf : s.surfels)
+    for (const Voxel v : {sf.inside(), sf.outside()}) {
+      if (checked++ % 3) continue;  // a third of them: the classification is O(log F) each
+      const auto p = s.geometry.toPhysical({double(v.x), double(v.y), double(v.z)});
+      const auto where = side(ck::Kernel::Point_3(p[0], p[1], p[2]));
+      const bool inside = where == CGAL::ON_BOUNDED_SIDE;
+      if (where == CGAL::ON_BOUNDARY || inside != bool(image(v.x, v.y, v.z)))
+        if (++wrong <= 3) ADD_FAILURE() << what << ": voxel " << v << " is on the wrong side";
+    }
+}
+
+/// Decimation's bounds: sampled distance both ways within maxError (plus rounding).
+void expectWithin(const Surface& original, const Surface& decimated, double maxError, const std::string& what) {
+  const ck::CgalMesh a = ck::cgalMesh(original.vertices, original.triangles);
+  const ck::CgalMesh b = ck::cgalMesh(decimated.vertices, decimated.triangles);
+  EXPECT_LE(ck::sampledDistance(original.vertices, original.triangles, b), maxError * (1 + 1e-6)) << what;
+  EXPECT_LE(ck::sampledDistance(decimated.vertices, decimated.triangles, a), maxError * (1 + 1e-6)) << what;
+}
+
+Surface extractAll(const DenseImage<std::uint8_t>& image, AdjacencyPair pair) {
+  ExtractOptions o;
+  o.selection = Selection::label(1);
+  o.seed = SeedRule::all();
+  o.pair = pair;
+  o.threads = 1;
+  return extract(VolumeView::of(image.data().data(), image.dims(), image.geometry()), o);
+}
+
+}  // namespace
+
+class RefineRandomImages : public ::testing::TestWithParam<AdjacencyPair> {};
+
+// 300 random images per pair (1,200 in all), 3 to 7 voxels a side, densities 0.2 to 0.8.
+TEST_P(RefineRandomImages, SmoothingAndDecimationKeepTopologyAndSides) {
+  const AdjacencyPair pair = GetParam();
+  std::mt19937_64 rng(20261201 + int(pair));
+  for (int trial = 0; trial < 300; ++trial) {
+    std::uniform_int_distribution<int> side(3, 7);
+    const Dims dims{side(rng), side(rng), side(rng)};
+    const double density = std::uniform_real_distribution<double>(0.2, 0.8)(rng);
+    DenseImage<std::uint8_t> image(dims);
+    for (auto& v : image.data()) v = std::uniform_real_distribution<double>(0, 1)(rng) < density;
+    if (std::count(image.data().begin(), image.data().end(), 1) == 0) continue;
+    const std::string what = "trial " + std::to_string(trial);
+    Surface s = extractAll(image, pair);
+    const Shape before = shapeOf(s);
+    ASSERT_EQ(before.selfIntersections, 0u) << what << ": the midpoint mesh itself";
+    const auto binary = [&](int x, int y, int z) { return dims.contains(x, y, z) && image.at(x, y, z) == 1; };
+
+    SmoothOptions so;
+    so.iterations = 10;
+    const SmoothReport sr = smooth(s, so);
+    EXPECT_EQ(sr.unguardedCubes, 0u) << what;
+    expectSameTopology(before, s, what + " smoothed");
+    expectOnSegments(s, so.epsilon, what + " smoothed");
+    expectVoxelSides(s, binary, {-1, -1, -1}, {dims.nx, dims.ny, dims.nz}, what + " smoothed");
+
+    const Surface smoothed = s;
+    DecimateOptions dop;
+    dop.maxError = 0.4;
+    dop.reduction = 0.5;
+    decimate(s, dop);
+    expectSameTopology(before, s, what + " decimated");
+    expectWithin(smoothed, s, *dop.maxError, what + " decimated");
+    if (HasFailure()) return;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Pairs, RefineRandomImages,
+                         ::testing::Values(AdjacencyPair::k26_6, AdjacencyPair::k18_6, AdjacencyPair::k6_18,
+                                           AdjacencyPair::k6_26),
+                         surftrack::testing::pairTestName);
+
+namespace {
+
+/// Smooths, then decimates, `s` (extracted from `binary`) and checks both results; returns the
+/// decimated surface's figures for further checks.
+template <class BinaryImage>
+void checkSmoothThenDecimate(Surface s, const BinaryImage& binary, double maxError, std::optional<double> reduction,
+                             const std::string& what) {
+  const Shape before = shapeOf(s);
+  ASSERT_TRUE(before.topology.closedOriented) << what << ": " << before.topology.problem;
+  const std::size_t intersectionsBefore = before.selfIntersections;
+  SmoothOptions so;
+  const SmoothReport sr = smooth(s, so);
+  Shape expected = before;
+  expected.selfIntersections = 0;
+  const Shape after = shapeOf(s);
+  EXPECT_TRUE(after.topology.closedOriented) << what << ": " << after.topology.problem;
+  EXPECT_TRUE(after.topology.manifoldVertices) << what << ": " << after.topology.problem;
+  EXPECT_EQ(after.topology.euler, before.topology.euler) << what;
+  EXPECT_EQ(after.topology.components, before.topology.components) << what;
+  // Cubes not embedded in the input are not guarded; none may be added.
+  if (sr.unguardedCubes == 0) EXPECT_EQ(after.selfIntersections, 0u) << what << " smoothed";
+  else EXPECT_LE(after.selfIntersections, intersectionsBefore) << what << " smoothed";
+  expectOnSegments(s, so.epsilon, what + " smoothed");
+  expectVoxelSidesNearSurface(s, binary, what + " smoothed");
+  EXPECT_GT(sr.maxDisplacement, 0) << what;
+
+  const Surface smoothed = s;
+  DecimateOptions dop;
+  dop.maxError = maxError;
+  dop.reduction = reduction;
+  const DecimateReport dr = decimate(s, dop);
+  EXPECT_LT(dr.trianglesAfter, dr.trianglesBefore) << what;
+  const Shape decimated = shapeOf(s);
+  EXPECT_TRUE(decimated.topology.closedOriented) << what << ": " << decimated.topology.problem;
+  EXPECT_TRUE(decimated.topology.manifoldVertices) << what << ": " << decimated.topology.problem;
+  EXPECT_EQ(decimated.topology.euler, before.topology.euler) << what;
+  EXPECT_EQ(decimated.topology.components, before.topology.components) << what;
+  EXPECT_EQ(decimated.selfIntersections, 0u) << what << " decimated";
+  expectWithin(smoothed, s, maxError, what + " decimated");
+  // Survivors are still surfels, on their segments.
+  expectOnSegments(s, so.epsilon, what + " decimated");
+}
+
+template <class T>
+Surface extractFrom(const DenseImage<T>& image, Selection selection, SeedRule seed, Mapping mapping = Mapping::Default) {
+  ExtractOptions o;
+  o.selection = selection;
+  o.seed = seed;
+  o.mapping = mapping;
+  o.threads = 1;
+  return extract(VolumeView::of(image.data().data(), image.dims(), image.geometry()), o);
+}
+
+}  // namespace
+
+// The noisy sphere of Figure 9 (q = 64, 1 % noise): every boundary, midpoint and linear mappings.
+TEST(RefineVolumes, Figure9NoisySphere) {
+  const NoisyPhantom p = makeNoisySphere(64, 0.01);
+  const auto binary = p.binary();
+  checkSmoothThenDecimate(extractFrom(p.image, Selection::threshold(p.iso), SeedRule::all(), Mapping::Midpoint),
+                          binary, 0.5, 0.8, "sphere, midpoint");
+  checkSmoothThenDecimate(extractFrom(p.image, Selection::threshold(p.iso), SeedRule::all(), Mapping::Linear),
+                          binary, 0.5, std::nullopt, "sphere, linear");
+}
+
+// The demo's phantom (sphere minus three cylinders, genus 5), anisotropic and mirrored geometry.
+TEST(RefineVolumes, DemoPhantomInAMirroredAnisotropicFrame) {
+  SphereMinusCylinders p = makeSphereMinusCylinders(48, 0.01);
+  ImageGeometry g;
+  g.spacing = {0.8, 1.0, 1.3};
+  g.origin = {10, -5, 3};
+  g.direction = {{{-1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  p.image.geometry() = g;
+  const auto binary = p.binary();
+  Surface s = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::fromSurfel(p.seed), Mapping::Midpoint);
+  EXPECT_EQ(componentFigures(s.vertices, s.triangles).front().genus(), 5.0);
+  checkSmoothThenDecimate(s, binary, 0.6, 0.9, "phantom");
+}
+
+// The decimation's triangle target, with no error bound: met within 5 %.
+TEST(RefineVolumes, DecimationMeetsItsTarget) {
+  const NoisyPhantom p = makeNoisySphere(48, 0.0);
+  for (double reduction : {0.5, 0.75, 0.9}) {
+    Surface s = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::largest(), Mapping::Midpoint);
+    smooth(s, {});
+    DecimateOptions d;
+    d.reduction = reduction;
+    const DecimateReport r = decimate(s, d);
+    const double target = (1 - reduction) * double(r.trianglesBefore);
+    EXPECT_NEAR(double(s.triangles.size()), target, 0.05 * target) << "reduction " << reduction;
+    const Shape shape = shapeOf(s);
+    EXPECT_EQ(shape.topology.euler, 2);
+    EXPECT_EQ(shape.selfIntersections, 0u);
+  }
+}
+
+TEST(RefineErrors, BadOptionsAndInputsThrowInvalidInput) {
+  const NoisyPhantom p = makeNoisySphere(16, 0.0);
+  Surface s = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::largest(), Mapping::Midpoint);
+  SmoothOptions bad;
+  bad.lambda = 0;
+  EXPECT_THROW(smooth(s, bad), InvalidInput);
+  bad = {};
+  bad.mu = -0.4;  // not below -lambda
+  EXPECT_THROW(smooth(s, bad), InvalidInput);
+  bad = {};
+  bad.epsilon = 0.5;
+  EXPECT_THROW(smooth(s, bad), InvalidInput);
+  EXPECT_THROW(decimate(s, {}), InvalidInput);  // neither bound nor target
+  DecimateOptions d;
+  d.reduction = 1.0;
+  EXPECT_THROW(decimate(s, d), InvalidInput);
+  d.reduction = std::nullopt;
+  d.maxError = -1;
+  EXPECT_THROW(decimate(s, d), InvalidInput);
+  // A decimated surface is no longer a continuous analog: its triangles leave their cubes.
+  d.maxError = 1.0;
+  decimate(s, d);
+  EXPECT_THROW(smooth(s, {}), InvalidInput);
+  // A vertex moved off its segment.
+  Surface t = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::largest(), Mapping::Midpoint);
+  t.vertices[0][0] += 0.25;
+  t.vertices[0][1] += 0.25;
+  t.vertices[0][2] += 0.25;
+  EXPECT_THROW(smooth(t, {}), InvalidInput);
+}
+
+#ifdef SURFTRACK_TEST_MRICRON
+#include <filesystem>
+
+#include "ReadVolume.h"
+
+namespace {
+
+/// The block [lo, lo + size) of `image`, with the geometry that keeps its voxels in place.
+template <class T>
+DenseImage<T> crop(const DenseImage<T>& image, Voxel lo, int size) {
+  DenseImage<T> out(Dims{size, size, size});
+  for (int z = 0; z < size; ++z)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) out.at(x, y, z) = image.at(lo.x + x, lo.y + y, lo.z + z);
+  out.geometry() = image.geometry();
+  out.geometry().origin = image.geometry().toPhysical({double(lo.x), double(lo.y), double(lo.z)});
+  return out;
+}
+
+}  // namespace
+
+// A 56^3 block of the Colin27 MRI (ch2better.nii.gz, 0.5 mm, mirrored frame) through the
+// cortex: every boundary at the demo's iso-value 100, linear mapping.
+TEST(RefineVolumes, MriCortexBlock) {
+  const std::string path = std::string(SURFTRACK_TEST_MRICRON) + "/ch2better.nii.gz";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
+  const auto volume = std::get<DenseImage<std::uint8_t>>(io::readVolume(path));
+  const DenseImage<std::uint8_t> block = crop(volume, {118, 158, 208}, 56);
+  const ThresholdImage<std::uint8_t> binary(block, 100.0);
+  checkSmoothThenDecimate(extractFrom(block, Selection::threshold(100), SeedRule::all()), binary, 0.25, 0.7,
+                          "MRI block");
+}
+
+// An atlas label (aal.nii.gz, label 1: the left precentral gyrus), the whole region.
+TEST(RefineVolumes, AtlasLabel) {
+  const std::string path = std::string(SURFTRACK_TEST_MRICRON) + "/aal.nii.gz";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
+  const io::AnyVolume volume = io::readVolume(path);
+  std::visit(
+      [&](const auto& image) {
+        using T = typename std::decay_t<decltype(image)>::value_type;
+        const LabelImage<T> binary(image, T(1));
+        checkSmoothThenDecimate(extractFrom(image, Selection::label(1), SeedRule::largest()), binary, 0.5, 0.8,
+                                "AAL label 1");
+      },
+      volume);
+}
+#endif
