@@ -35,6 +35,35 @@ std::vector<T> parseList(const std::string& text, const std::string& what) {
   return out;
 }
 
+/// A benchmark's command line, option by option: `for (Arguments args(argc, argv); args.next();)`,
+/// then `args.is("--sizes")`, `args.value()` for the argument that follows the option, and
+/// `args.unknown()` for one no branch took. Errors are std::invalid_argument, one line each.
+class Arguments {
+ public:
+  Arguments(int argc, char** argv) : argc_(argc), argv_(argv) {}
+  bool next() {
+    if (++i_ >= argc_) return false;
+    current_ = argv_[i_];
+    return true;
+  }
+  const std::string& current() const { return current_; }
+  bool is(const char* name) const { return current_ == name; }
+  bool isHelp() const { return current_ == "--help" || current_ == "-h"; }
+  std::string value() {
+    if (i_ + 1 >= argc_) throw std::invalid_argument(current_ + " needs a value");
+    return argv_[++i_];
+  }
+  [[noreturn]] void unknown() const {
+    throw std::invalid_argument("unknown option " + current_ + " (see --help)");
+  }
+
+ private:
+  int argc_;
+  char** argv_;
+  int i_ = 0;
+  std::string current_;
+};
+
 inline double wallSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }

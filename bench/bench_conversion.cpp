@@ -47,23 +47,18 @@ int main(int argc, char** argv) {
     std::vector<int> sizes{128, 256, 512};
     int reps = 5;
     AdjacencyPair pair = AdjacencyPair::k26_6;
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-        return argv[++i];
-      };
-      if (a == "--help" || a == "-h") {
+    for (bench::Arguments args(argc, argv); args.next();) {
+      if (args.isHelp()) {
         std::cout << kUsage;
         return 0;
-      } else if (a == "--sizes") {
-        sizes = bench::parseList<int>(value(), "size");
-      } else if (a == "--reps") {
-        reps = std::stoi(value());
-      } else if (a == "--pair") {
-        pair = parseAdjacencyPair(value());
+      } else if (args.is("--sizes")) {
+        sizes = bench::parseList<int>(args.value(), "size");
+      } else if (args.is("--reps")) {
+        reps = std::stoi(args.value());
+      } else if (args.is("--pair")) {
+        pair = parseAdjacencyPair(args.value());
       } else {
-        throw std::invalid_argument("unknown option " + a + " (see --help)");
+        args.unknown();
       }
     }
     std::printf("conversion, pair %s, median of %d runs, one thread (ms; M triangles/s)\n",

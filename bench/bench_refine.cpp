@@ -61,31 +61,26 @@ int main(int argc, char** argv) {
     double maxError = 0.5, reduce = 0.9;
     SmoothOptions so;
     std::string out = ".";
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-        return argv[++i];
-      };
-      if (a == "--help" || a == "-h") {
+    for (bench::Arguments args(argc, argv); args.next();) {
+      if (args.isHelp()) {
         std::cout << kUsage;
         return 0;
-      } else if (a == "--size") {
-        q = std::stoi(value());
-      } else if (a == "--iterations") {
-        iterations = std::stoi(value());
-      } else if (a == "--max-error") {
-        maxError = std::stod(value());
-      } else if (a == "--reduce") {
-        reduce = std::stod(value());
-      } else if (a == "--lambda") {
-        so.lambda = std::stod(value());
-      } else if (a == "--mu") {
-        so.mu = std::stod(value());
-      } else if (a == "--out") {
-        out = value();
+      } else if (args.is("--size")) {
+        q = std::stoi(args.value());
+      } else if (args.is("--iterations")) {
+        iterations = std::stoi(args.value());
+      } else if (args.is("--max-error")) {
+        maxError = std::stod(args.value());
+      } else if (args.is("--reduce")) {
+        reduce = std::stod(args.value());
+      } else if (args.is("--lambda")) {
+        so.lambda = std::stod(args.value());
+      } else if (args.is("--mu")) {
+        so.mu = std::stod(args.value());
+      } else if (args.is("--out")) {
+        out = args.value();
       } else {
-        throw std::invalid_argument("unknown option " + a + " (see --help)");
+        args.unknown();
       }
     }
     const NoisyPhantom sphere = makeNoisySphere(q, 0.0);

@@ -155,22 +155,17 @@ int main(int argc, char** argv) {
     int reps = 5;
     AdjacencyPair pair = AdjacencyPair::k26_6;
     bool implicitBall = true, baseline = true, breakdown = false;
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-        return argv[++i];
-      };
-      if (a == "--help" || a == "-h") {
+    for (bench::Arguments args(argc, argv); args.next();) {
+      if (args.isHelp()) {
         std::cout << kUsage;
         return 0;
-      } else if (a == "--sizes") sizes = bench::parseList<int>(value(), "size");
-      else if (a == "--quick") sizes = {64, 128, 256}, reps = 3, implicitBall = false;
-      else if (a == "--reps") reps = std::stoi(value());
-      else if (a == "--pair") pair = parseAdjacencyPair(value());
-      else if (a == "--no-baseline") baseline = false;
-      else if (a == "--breakdown") breakdown = true;
-      else throw std::invalid_argument("unknown option " + a + " (see --help)");
+      } else if (args.is("--sizes")) sizes = bench::parseList<int>(args.value(), "size");
+      else if (args.is("--quick")) sizes = {64, 128, 256}, reps = 3, implicitBall = false;
+      else if (args.is("--reps")) reps = std::stoi(args.value());
+      else if (args.is("--pair")) pair = parseAdjacencyPair(args.value());
+      else if (args.is("--no-baseline")) baseline = false;
+      else if (args.is("--breakdown")) breakdown = true;
+      else args.unknown();
     }
     std::printf("trackComponent throughput, pair %s, median of %d runs, one thread\n",
                 toString(pair).c_str(), reps);

@@ -87,30 +87,26 @@ int main(int argc, char** argv) {
     int radius = 60;
     bool withBig = true;
     std::string dir;
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-        return argv[++i];
-      };
-      if (a == "--help" || a == "-h") {
+    for (bench::Arguments args(argc, argv); args.next();) {
+      const std::string& a = args.current();
+      if (args.isHelp()) {
         std::cout << kUsage;
         return 0;
-      } else if (a == "--sizes") {
-        sizes = bench::parseList<int>(value(), "size");
-      } else if (a == "--noise") {
-        noises = bench::parseList<double>(value(), "noise");
-      } else if (a == "--big") {
-        big = bench::parseList<int>(value(), "dimension");
+      } else if (args.is("--sizes")) {
+        sizes = bench::parseList<int>(args.value(), "size");
+      } else if (args.is("--noise")) {
+        noises = bench::parseList<double>(args.value(), "noise");
+      } else if (args.is("--big")) {
+        big = bench::parseList<int>(args.value(), "dimension");
         if (big.size() != 3) throw std::invalid_argument("--big needs NX,NY,NZ");
-      } else if (a == "--radius") {
-        radius = std::stoi(value());
-      } else if (a == "--no-big") {
+      } else if (args.is("--radius")) {
+        radius = std::stoi(args.value());
+      } else if (args.is("--no-big")) {
         withBig = false;
       } else if (!a.empty() && a[0] != '-' && dir.empty()) {
         dir = a;
       } else {
-        throw std::invalid_argument("unknown option " + a + " (see --help)");
+        args.unknown();
       }
     }
     if (dir.empty()) throw std::invalid_argument("no output directory (see --help)");

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <map>
 #include <set>
@@ -183,7 +184,8 @@ int runLabels(const std::vector<std::string>& args) {
     std::cout << "surftrack labels: " << rows.size() << " label" << (rows.size() == 1 ? "" : "s") << ", "
               << boundaries << " boundaries, " << surfels << " surfels -> " << o.output << "\n";
     if (!namesFile.empty()) std::cout << "  names      " << namesFile << "\n";
-    for (const StageTiming& s : run.timings) std::cout << "  " << s.name << std::string(11 - s.name.size(), ' ') << num(s.seconds, 3) << " s\n";
+    for (const StageTiming& s : run.timings)
+      std::cout << "  " << std::left << std::setw(11) << s.name << std::right << num(s.seconds, 3) << " s\n";
   }
   return 0;
 }

@@ -24,12 +24,6 @@ void forEachValue(const VolumeView& view, F&& f) {
     }
 }
 
-/// Calls f(T{}) with the type of the view's voxels.
-template <class F>
-decltype(auto) visitView(const VolumeView& view, F&& f) {
-  return visitScalarType(view.type, std::forward<F>(f));
-}
-
 template <class T>
 VolumeStats statsOf(const VolumeView& view) {
   VolumeStats s;
@@ -132,7 +126,7 @@ double VolumeStats::quantile(double q) const {
 }
 
 std::optional<std::array<double, 2>> valueRange(const VolumeView& volume) {
-  return visitView(volume, [&](auto type) -> std::optional<std::array<double, 2>> {
+  return visitScalarType(volume.type, [&](auto type) -> std::optional<std::array<double, 2>> {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     forEachValue<decltype(type)>(volume, [&](auto v) {
       const double d = double(v);
@@ -147,11 +141,11 @@ std::optional<std::array<double, 2>> valueRange(const VolumeView& volume) {
 }
 
 VolumeStats computeStats(const VolumeView& volume) {
-  return visitView(volume, [&](auto type) { return statsOf<decltype(type)>(volume); });
+  return visitScalarType(volume.type, [&](auto type) { return statsOf<decltype(type)>(volume); });
 }
 
 std::size_t countAbove(const VolumeView& volume, double s) {
-  return visitView(volume, [&](auto type) {
+  return visitScalarType(volume.type, [&](auto type) {
     std::size_t n = 0;
     forEachValue<decltype(type)>(volume, [&](auto v) { n += double(v) > s; });
     return n;
@@ -159,7 +153,7 @@ std::size_t countAbove(const VolumeView& volume, double s) {
 }
 
 std::size_t countEqual(const VolumeView& volume, double label) {
-  return visitView(volume, [&](auto type) {
+  return visitScalarType(volume.type, [&](auto type) {
     std::size_t n = 0;
     forEachValue<decltype(type)>(volume, [&](auto v) { n += double(v) == label; });
     return n;

@@ -8,7 +8,6 @@
 
 #include "BoundaryMapping.h"
 #include "CubeFoldCheck.h"
-#include "Hash.h"
 
 namespace surftrack::refine {
 
@@ -33,13 +32,6 @@ void requireParameters(const SmoothingParameters& p) {
   else return;
   throw std::invalid_argument(msg.str());
 }
-
-struct VoxelHash {
-  std::size_t operator()(const Voxel& v) const {
-    return std::size_t(mix64((std::uint64_t(std::uint32_t(v.x)) << 42) ^ (std::uint64_t(std::uint32_t(v.y)) << 21) ^
-                             std::uint64_t(std::uint32_t(v.z))));
-  }
-};
 
 /// Compressed lists: the items of list i are items[start[i] .. start[i + 1]).
 struct Lists {
@@ -101,7 +93,7 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
   // each triangle's reference normal: its normal in index space at the midpoint mapping.
   std::vector<std::array<std::uint32_t, 3>> triangle(nf);
   std::vector<std::uint32_t> cubeOfFace(nf);
-  std::unordered_map<Voxel, std::uint32_t, VoxelHash> cubeIndex;
+  std::unordered_map<Voxel, std::uint32_t> cubeIndex;  // std::hash<Voxel>: lib/Voxel.h
   cubeIndex.reserve(nf);
   std::vector<Point3> reference(nf);
   for (std::size_t f = 0; f < nf; ++f) {

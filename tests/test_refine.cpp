@@ -138,8 +138,12 @@ TEST_P(RefineRandomImages, SmoothingAndDecimationKeepTopologyAndSides) {
 
     SmoothOptions so;
     so.iterations = 10;
+    const Surface unsmoothed = s;
     const SmoothReport sr = smooth(s, so);
     EXPECT_EQ(sr.unguardedCubes, 0u) << what;
+    // Smoothing moves points only: the triangles and the surfels of the vertices are the same.
+    EXPECT_EQ(s.triangles, unsmoothed.triangles) << what;
+    EXPECT_EQ(s.surfels, unsmoothed.surfels) << what;
     expectSameTopology(before, s, what + " smoothed");
     expectOnSegments(s, so.epsilon, what + " smoothed");
     expectVoxelSides(s, binary, {-1, -1, -1}, {dims.nx, dims.ny, dims.nz}, what + " smoothed");

@@ -296,7 +296,10 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
 
   stages.begin("place");
   placeSurface(source, std::move(mesh), out.mapping, o.selection, o.epsilon, out);
-  out.voxelsRead = binary.voxelsRead() + (out.mapping == Mapping::Linear ? 2 * out.surfels.size() : 0);
+  // A scan (all, largest) reads the whole domain; the rest is what the seed rule, the tracker and
+  // the linear mapping asked for.
+  out.voxelsRead = binary.voxelsRead() + (out.mapping == Mapping::Linear ? 2 * out.surfels.size() : 0) +
+                   (o.seed.kind == Kind::All || o.seed.kind == Kind::Largest ? binary.dims().count() : 0);
 
   stages.begin("figures");
   if (o.figures) addFigures(out);

@@ -134,14 +134,6 @@ void append(TriangleMesh& to, TriangleMesh&& from) {
   for (auto t : from.triangles) to.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
 }
 
-TriangleMesh convert(const SurfaceGraph& graph) {
-  try {
-    return extractLoops(graph);  // from the bricks the tracker read: the same image
-  } catch (const std::logic_error& e) {
-    throw InternalError(e.what());
-  }
-}
-
 template <class T>
 std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource& source, const LabelOptions& o) {
   if (!holdsValue<T>(o.background))
@@ -185,18 +177,25 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
     TriangleMesh mesh;
     std::optional<SurfaceGraph> largest;
     std::size_t boundaries = 0;
+    // Loops from the bricks the tracker read: the same image. A logic_error of the tracker or
+    // the converter is an engine bug; the front door's own errors pass through as they are
+    // (InvalidInput is a std::logic_error too).
     try {
       trackBoundaries(binary, seeds.surfels[i], wanted[i], o.pair, [&](SurfaceGraph&& graph) {
         ++boundaries;
         if (o.boundaries != LabelBoundaries::Largest)
-          append(mesh, convert(graph));
+          append(mesh, extractLoops(graph));
         else if (!largest || graph.surfelCount() > largest->surfelCount())
           largest = std::move(graph);
       });
+      if (largest) mesh = extractLoops(*largest);
+    } catch (const InvalidInput&) {
+      throw;
+    } catch (const InternalError&) {
+      throw;
     } catch (const std::logic_error& e) {
       throw InternalError(e.what());
     }
-    if (largest) mesh = convert(*largest);
     std::vector<std::uint64_t>().swap(seeds.surfels[i]);  // done with them: the output grows
     LabelSurface& result = out[r];
     result.label = selection.value;

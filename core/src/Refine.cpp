@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ConstrainedSmoothing.h"
+#include "PlaceSurface.h"
 #include "SurfaceMesh.h"
 #include "TopologySafeDecimation.h"
 
@@ -31,15 +32,36 @@ void store(const SurfaceMesh& mesh, Surface& s) {
     int k = 0;
     for (auto vh : mesh.fv_range(fh)) s.triangles[fh.idx()][k++] = std::uint32_t(vh.idx());
   }
-  s.components = componentFigures(s.vertices, s.triangles);
-  s.euler = 0;
-  for (const ComponentFigures& c : s.components) s.euler += c.euler;
+  addFigures(s);
 }
 
+/// The enclosed volume of the surface, from its triangles (its components may not be computed:
+/// extract with figures off).
 double volumeOf(const Surface& s) {
   double v = 0;
   for (const ComponentFigures& c : componentFigures(s.vertices, s.triangles)) v += c.volume;
   return v;
+}
+
+/// The same after store(), from the figures it has just computed.
+double storedVolume(const Surface& s) {
+  double v = 0;
+  for (const ComponentFigures& c : s.components) v += c.volume;
+  return v;
+}
+
+/// Runs a refine/ algorithm with its errors as the front door's: a bad argument is the
+/// caller's (InvalidInput), a broken invariant the engine's (InternalError). (The order of the
+/// handlers matters: std::invalid_argument is a std::logic_error.)
+template <class F>
+auto translatingErrors(F&& f) {
+  try {
+    return f();
+  } catch (const std::invalid_argument& e) {
+    throw InvalidInput(e.what());
+  } catch (const std::logic_error& e) {
+    throw InternalError(e.what());
+  }
 }
 
 }  // namespace
@@ -53,21 +75,15 @@ SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
   SmoothReport report;
   report.volumeBefore = volumeOf(surface);
   SurfaceMesh mesh = meshOf(surface);
-  refine::SmoothingReport r;
-  try {
-    r = refine::smoothOnSegments(mesh, surface.geometry, p);
-  } catch (const std::invalid_argument& e) {
-    throw InvalidInput(e.what());
-  } catch (const std::logic_error& e) {
-    throw InternalError(e.what());
-  }
+  const refine::SmoothingReport r =
+      translatingErrors([&] { return refine::smoothOnSegments(mesh, surface.geometry, p); });
   store(mesh, surface);
   report.iterations = o.iterations;
   report.cubes = r.cubes;
   report.unguardedCubes = r.unguardedCubes;
   report.stepsBack = r.stepsBack;
   report.maxDisplacement = r.maxDisplacement;
-  report.volumeAfter = volumeOf(surface);
+  report.volumeAfter = storedVolume(surface);
   return report;
 }
 
@@ -81,19 +97,12 @@ DecimateReport decimate(Surface& surface, const DecimateOptions& o) {
   DecimateReport report;
   report.volumeBefore = volumeOf(surface);
   SurfaceMesh mesh = meshOf(surface);
-  refine::DecimationReport r;
-  try {
-    r = refine::decimateSafely(mesh, p);
-  } catch (const std::invalid_argument& e) {
-    throw InvalidInput(e.what());
-  } catch (const std::logic_error& e) {
-    throw InternalError(e.what());
-  }
+  const refine::DecimationReport r = translatingErrors([&] { return refine::decimateSafely(mesh, p); });
   store(mesh, surface);
   report.trianglesBefore = r.trianglesBefore;
   report.trianglesAfter = r.trianglesAfter;
   report.targetTriangles = r.targetTriangles;
-  report.volumeAfter = volumeOf(surface);
+  report.volumeAfter = storedVolume(surface);
   return report;
 }
 

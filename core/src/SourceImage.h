@@ -1,7 +1,8 @@
 // A VoxelSource with a selection, seen as the binary image the engine's templates read
 // (internal to core/): BinaryBrickCache takes whole bricks through rows(), the scanner whole
-// rows through row(), seed walks single voxels through operator(). It counts the voxels it
-// asks for (Surface::voxelsRead), from any number of threads.
+// rows through row(), seed walks single voxels through operator(). It counts the voxels the
+// seeded paths ask for (Surface::voxelsRead); the scanner's rows, read from several threads,
+// are not counted one by one (a scan reads every voxel: extract counts the domain).
 #pragma once
 
 #include <atomic>
@@ -30,10 +31,9 @@ class SourceImage {
     source_->binaryBlock(selection_, Voxel{x0, y0, z0}, width, ny, nz, out);
   }
   std::uint64_t row(int x0, int y, int z, int count) const {
-    this->count(std::uint64_t(count));
     return source_->binaryRow(selection_, Voxel{x0, y, z}, count);
   }
-  /// Voxels asked of the source so far.
+  /// Voxels asked of the source so far through operator() and rows().
   std::uint64_t voxelsRead() const { return read_.load(std::memory_order_relaxed); }
 
  private:

@@ -10,6 +10,7 @@
 #include "Extract.h"
 #include "Labels.h"
 #include "MeshIO.h"
+#include "SelectionValue.h"
 #include "SurfaceMesh.h"
 
 namespace surftrack {
@@ -42,7 +43,7 @@ void put(std::ofstream& out, T value) {
 /// A label as the PLY int property (labels beyond int32 do not fit it).
 std::int32_t plyLabel(double label) {
   if (!(label >= std::numeric_limits<std::int32_t>::min() && label <= std::numeric_limits<std::int32_t>::max()))
-    throw InvalidInput("label " + std::to_string(label) + " does not fit the PLY int label property");
+    throw InvalidInput("label " + numberText(label) + " does not fit the PLY int label property");
   return std::int32_t(label);
 }
 

@@ -141,7 +141,7 @@ struct Surface {
   std::vector<StageTime> timings;
   /// Voxels the extraction asked of the source: its bricks (apron included), rows and gray
   /// values. What a lazy source (a memory-mapped file) has to read; a seeded extraction keeps
-  /// it proportional to the surface, a scan reads every voxel once or more.
+  /// it proportional to the surface, a scan (all, largest) counts the whole domain.
   std::uint64_t voxelsRead = 0;
 
   std::size_t vertexCount() const { return vertices.size(); }

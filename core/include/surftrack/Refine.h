@@ -4,7 +4,7 @@
 // Euler characteristic; docs/theory.md, sections 8 and 10, says why.
 //
 //   surftrack::Surface s = surftrack::extract(view, options);
-//   surftrack::smooth(s, {});                               // 10 Taubin lambda|mu iterations
+//   surftrack::smooth(s, {});                               // 20 Taubin lambda|mu iterations
 //   surftrack::DecimateOptions d;  d.maxError = 0.5;  d.reduction = 0.9;
 //   surftrack::decimate(s, d);
 #pragma once
@@ -37,7 +37,7 @@ struct DecimateOptions {
   std::optional<double> maxError;
   /// Fraction of the triangles to remove, in [0, 1[ (as VTK's TargetReduction).
   std::optional<double> reduction;
-  double maxNormalDeviation = 60;  ///< degrees: no triangle normal turns more
+  double maxNormalDeviation = 60;  ///< degrees: no collapse turns a triangle normal more (OpenMesh's normal-flip guard, per collapse)
 };
 
 struct DecimateReport {
