@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The checks CI runs after the README's test command (.ci/run):
+#   1. the whole test suite again, in a build of its own with AddressSanitizer and
+#      UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its test);
+#   2. the libFuzzer targets of fuzz/ (the header readers that locate voxel data), each for a
+#      bounded time, seeded with the test files (fuzz/run_fuzzers.sh).
+#
+#   scripts/ci-checks.sh [seconds per fuzz target, default 20]
+#
+# Needs what scripts/setup.sh installs, plus clang for the fuzzers (installed here when missing).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-20}
+here=$PWD
+
+if ! command -v clang++ >/dev/null; then
+  sudo=""
+  [[ $(id -u) -eq 0 ]] || sudo="sudo"
+  echo "ci-checks: installing clang (the fuzzers)" >&2
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq clang >/dev/null
+fi
+
+start=$(date +%s)
+# -O1 with line tables: readable sanitizer stacks at a fraction of -O3's compile time.
+cmake -S . -B build-sanitize -DSURFTRACK_SANITIZE=ON -DSURFTRACK_BUILD_BENCH=OFF \
+      -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" >/dev/null
+cmake --build build-sanitize -j2 >build-sanitize.log 2>&1 || { tail -60 build-sanitize.log; exit 1; }
+built=$(date +%s)
+echo "ci-checks: sanitized build in $((built - start)) s"
+# Leaks inside third-party readers on their error paths are theirs (tests/lsan.supp names each);
+# every other leak, and every ASan or UBSan report, fails the test that caused it.
+ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1" \
+LSAN_OPTIONS="suppressions=$here/tests/lsan.supp:print_suppressions=0" \
+UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+  ctest --test-dir build-sanitize --output-on-failure -j2
+echo "ci-checks: sanitized test suite in $(($(date +%s) - built)) s"
+
+bash fuzz/run_fuzzers.sh "$seconds" "$here/build-fuzz"
+echo "ci-checks: $(($(date +%s) - start)) s in all"
