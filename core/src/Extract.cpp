@@ -223,16 +223,15 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
     std::size_t expected = 0;
     switch (o.seed.kind) {
       case Kind::Largest: {
-        const TriangleMesh all = scanIsoSurface(binary, o.pair, o.threads);
-        std::size_t count = 0;
-        const std::vector<std::uint32_t> component = meshComponents(all, count);
-        if (count == 0) throwEmpty(source, o.selection);
-        std::vector<std::size_t> size(count, 0);
-        for (std::uint32_t c : component) ++size[c];
-        const std::size_t best = std::size_t(std::max_element(size.begin(), size.end()) - size.begin());
-        seed = all.surfels[std::size_t(std::find(component.begin(), component.end(), best) - component.begin())];
-        out.boundariesInImage = count;
-        expected = size[best];
+        // Every boundary's surfel count from a scan that builds no triangle; ties go to the
+        // boundary met first, as in the components of the scanned mesh.
+        const std::vector<BoundaryCount> boundaries = scanBoundaryCounts(binary, o.pair, o.threads);
+        if (boundaries.empty()) throwEmpty(source, o.selection);
+        const auto best = std::max_element(boundaries.begin(), boundaries.end(),
+                                           [](const BoundaryCount& a, const BoundaryCount& b) { return a.surfels < b.surfels; });
+        seed = best->seed;
+        out.boundariesInImage = boundaries.size();
+        expected = best->surfels;
         break;
       }
       case Kind::Ray: seed = resolveVoxelSeed(binary, o.seed.voxel, out.seed); break;
