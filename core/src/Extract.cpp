@@ -278,7 +278,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
 
     stages.begin("track");
     const SurfaceGraph graph =
-        trackComponent(binary, seed, o.pair, [&](std::size_t n) { stages.surfelsFound(n); });
+        trackComponent(binary, seed, o.pair, [&](std::size_t n) { stages.surfelsFound(n); }, o.threads);
     if (expected && graph.surfelCount() != expected) {
       std::ostringstream msg;
       msg << "tracking from " << seed << " found " << graph.surfelCount() << " surfels, the scan "
@@ -287,7 +287,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
     }
     stages.begin("convert");
     try {
-      mesh = extractLoops(graph);  // from the bricks the tracker read: the same image
+      mesh = extractLoops(graph, o.threads);  // from the bricks the tracker read: the same image
     } catch (const std::logic_error& e) {
       throw InternalError(e.what());
     }
