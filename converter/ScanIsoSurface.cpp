@@ -333,9 +333,21 @@ class Scanner {
     std::uint32_t base;
     void vertex(std::uint32_t, const Surfel&) {}
     void cube(unsigned config, const std::array<const std::uint32_t*, 12>& edge, int i) {
+      // The root of a patch's first edge is found once for the patch's other edges.
       const PatchJoins& joins = s.joins_[config];
-      for (int k = 0; k < joins.count; ++k)
-        sets.union_set(edge[joins.edge[k][0]][i] - base, edge[joins.edge[k][1]][i] - base);
+      int first = -1;
+      std::uint32_t root = 0;
+      for (int k = 0; k < joins.count; ++k) {
+        if (joins.edge[k][0] != first) {
+          first = joins.edge[k][0];
+          root = sets.find_set(edge[first][i] - base);
+        }
+        const std::uint32_t other = sets.find_set(edge[joins.edge[k][1]][i] - base);
+        if (other != root) {
+          sets.link(root, other);
+          root = sets.find_set(root);
+        }
+      }
     }
   };
 
