@@ -82,8 +82,8 @@ struct ExtractOptions {
   /// If set and raised, the extraction stops at the next check and throws Cancelled.
   const std::atomic<bool>* cancel = nullptr;
   /// Threads for the scanning method (largest, all), the second pass of tracking and the loop
-  /// extraction: 0 for all cores. The surface is the same for any number. The scanning method
-  /// then reads the source from several threads at once.
+  /// extraction and the placement of the vertices: 0 for all cores. The surface is the same for
+  /// any number. The source is then read from several threads at once.
   int threads = 0;
   /// Per-component figures (a union-find over the vertices): off, `components` stays empty,
   /// `euler` 0 and, for `all`, `boundariesInImage` 0 — for callers that need only the mesh.
