@@ -12,6 +12,9 @@
 //  - Vertices are shared between cubes without a global hash map (as in flying edges and
 //    OpenVDB's VolumeToMesh): before the cubes of a slab z..z+1 are visited, every cut grid edge
 //    of the slab gets its vertex index in small per-plane arrays indexed by edge position.
+//  - scanBoundaryCounts runs the same slabs but, instead of writing triangles, joins the
+//    surfels of each cube's patches in a union-find (Boost's disjoint sets): every boundary's
+//    surfel count and first surfel, for `--largest`, with no mesh built.
 //  - A dense ThresholdImage (any gray type, in particular the binaryView of a BinaryVolume) is
 //    binarised straight from its buffer, 16 uint8 voxels per SSE2 instruction; any other binary
 //    image (LabelImage, ImplicitImage, ...) is read through its operator().
