@@ -4,9 +4,9 @@
 Writes the inputs with bench_write_inputs (the Figure 9 noisy spheres as .mha, a sparse
 4.4 G-voxel raw file holding one ball), then runs on the same files, in the same run:
   - surftrack mesh (this build's CLI): one component from the protocol's seed surfel; the
-    largest boundary on 1 and on all threads; the big raw file from a seed voxel at the ball's
+    largest boundary on 1 and on all threads (the same file on both); the big raw file from a seed voxel at the ball's
     centre (its pages evicted from the page cache first, so what is resident afterwards is
-    what the run read); the demo's MRI cortex (ch2better.nii.gz, --largest);
+    what the run read); the demo's MRI cortex (ch2better.nii.gz, --largest, 1 and all threads);
   - VTK (python3-vtk9, when installed): vtkMetaImageReader -> vtkFlyingEdges3D ->
     vtkPolyDataConnectivityFilter (closest-point region, the seed surfel's midpoint) ->
     vtkPLYWriter, on 1 and on all threads;
@@ -140,6 +140,24 @@ def surftrack_runs(exe, args, reps, before=None):
     return times, peaks, reports
 
 
+def largest_on_threads(exe, case, args, out, reps, cores, show):
+    """`--largest` on 1 and on all threads: the same file each time (refused otherwise), and the
+    speed-up."""
+    largest, files = {}, {}
+    for threads in (1, cores):
+        path = out("lg%d.ply" % threads)
+        times, peaks, js = surftrack_runs(exe, args + ["-o", path, "--largest", "--threads", str(threads)], reps)
+        largest[threads] = Result(case, "surftrack --largest, %d thr" % threads, times, peaks,
+                                  stage_text(js[len(js) // 2]))
+        show(largest[threads])
+        with open(path, "rb") as f:
+            files[threads] = f.read()
+    if files[1] != files[cores]:
+        raise RuntimeError("%s: --largest wrote different files on 1 and %d threads" % (case, cores))
+    print("%-24s %-34s %9.2fx" % (case, "--largest speed-up %d thr / 1" % cores,
+                                  largest[1].seconds / largest[cores].seconds))
+
+
 def stage_text(j):
     t = j["timings_s"]
     total = sum(v for k, v in t.items() if k != "total")
@@ -230,15 +248,7 @@ def main():
             show(r)
             print("%-24s %-34s %9.2fx" % (case, "ratio surftrack / skimage", st.seconds / r.seconds))
         if s["q"] == max(x["q"] for x in manifest["spheres"]) and s["noise"] >= 0.05:
-            largest = {}
-            for threads in (1, cores):
-                times, peaks, js = surftrack_runs(exe, [f, "-o", out("lg.ply"), "--iso", str(s["iso"]), "--largest",
-                                                        "--threads", str(threads)], a.reps)
-                largest[threads] = Result(case, "surftrack --largest, %d thr" % threads, times, peaks,
-                                          stage_text(js[len(js) // 2]))
-                show(largest[threads])
-            print("%-24s %-34s %9.2fx" % (case, "--largest speed-up %d thr / 1" % cores,
-                                          largest[1].seconds / largest[cores].seconds))
+            largest_on_threads(exe, case, [f, "--iso", str(s["iso"])], out, a.reps, cores, show)
 
     if "big" in manifest:
         b = manifest["big"]
@@ -257,8 +267,8 @@ def main():
 
     mri = "/usr/share/mricron/templates/ch2better.nii.gz"
     if os.path.exists(mri):
-        times, peaks, js = surftrack_runs(exe, [mri, "-o", out("cortex.ply"), "--iso", "100", "--largest"], a.reps)
-        show(Result("MRI cortex (nii.gz)", "surftrack --largest", times, peaks, stage_text(js[len(js) // 2])))
+        largest_on_threads(exe, "MRI cortex (nii.gz)", [mri, "--iso", "100"], out, a.reps, cores, show)
+    print("load average at the end: %s" % " ".join("%.1f" % x for x in os.getloadavg()))
     if not a.keep:
         shutil.rmtree(a.dir, ignore_errors=True)
 

@@ -11,6 +11,7 @@
 // ever searched for: vertices are resolved through the arcs.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <sstream>
@@ -24,6 +25,9 @@
 #include "HugePages.h"
 #include "SurfaceGraph.h"
 #include "TriangleMesh.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace surftrack {
 
@@ -90,28 +94,29 @@ inline void walkPatch(const SurfaceGraph& graph, Voxel m, std::uint8_t config, i
     }
 }
 
-/// The loop algorithm over all vertices, reading cube configurations from `bricks`;
+/// The loop algorithm over vertices [begin, end), reading cube configurations from `bricks`;
 /// findBrick(bx, by, bz) gives the index in `bricks` of the brick of voxels 8 (bx, by, bz) +
-/// [0, 8)^3 (binarising it if need be) or throws.
+/// [0, 8)^3 (binarising it if need be) or throws. Each patch belongs to its first vertex (the
+/// smallest index among its surfels): the patches of the vertices of the range are appended to
+/// `triangles` in the order of their first vertex, then of its 4 cubes — the order of one walk
+/// over all vertices, so that ranges walked apart and joined in order give the same mesh.
+/// flags[v] bit q: the patch of surfel v in cube cubesOf(surfels[v])[q] has been walked; only
+/// the flags of the range are read and written.
 template <class FindBrick>
-TriangleMesh extractLoops(const SurfaceGraph& graph, const BinaryBricks& bricks, FindBrick&& findBrick) {
+void extractLoopsOf(const SurfaceGraph& graph, const BinaryBricks& bricks, FindBrick&& findBrick, std::uint32_t begin,
+                    std::uint32_t end, std::uint8_t* flags, std::vector<std::array<std::uint32_t, 3>>& triangles) {
   const std::vector<Surfel>& surfels = graph.surfels;
   const auto tables = configurationTables(graph.pair);
   const CubeLoops& loops = cubeLoops(graph.pair);
   const EdgeSurfels& onEdges = edgeSurfels();
-  TriangleMesh mesh;
-  reserveHugePages(mesh.surfels, surfels.size());
-  mesh.surfels.assign(surfels.begin(), surfels.end());
-  reserveHugePages(mesh.triangles, 2 * surfels.size() + 16);
-  // flags[v] bit q: the patch of surfel v in cube cubesOf(surfels[v])[q] has been emitted.
-  std::vector<std::uint8_t> flags(surfels.size(), 0);
+  auto inRange = [&](std::uint32_t u) { return u >= begin && u < end; };
   // The 4 cubes around a surfel lie in the 3x3x3 neighbourhood of its 1-voxel, which its brick
   // holds. Tracked graphs number their vertices brick by brick, so the brick of the last
   // surfel is almost always the brick of the next one: remember it rather than look it up.
   Voxel lastBrick{1 << 30, 0, 0};
   std::uint32_t brick = 0;
 
-  for (std::uint32_t v = 0; v < surfels.size(); ++v) {
+  for (std::uint32_t v = begin; v < end; ++v) {
     if (flags[v] == 0xF) continue;
     const Surfel& t = surfels[v];
     const Voxel brickOfT{t.c.x >> 3, t.c.y >> 3, t.c.z >> 3};
@@ -134,29 +139,77 @@ TriangleMesh extractLoops(const SurfaceGraph& graph, const BinaryBricks& bricks,
       std::array<std::uint32_t, cube::kEdges> byPosition;
       if (loop.length != 0 &&
           walkLoop(graph, m, onEdges[config], loop, loop.positionOf[edge], v, byPosition)) {
-        for (int i = 0; i < loop.triangleCount; ++i) {
-          const auto& tri = loop.triangles[i];
-          mesh.triangles.push_back({byPosition[tri[0]], byPosition[tri[1]], byPosition[tri[2]]});
+        std::uint32_t first = v;
+        for (int i = 0; i < loop.length; ++i) {
+          first = std::min(first, byPosition[i]);
+          if (inRange(byPosition[i])) flags[byPosition[i]] |= std::uint8_t(1u << loop.cubeSlot[i]);
         }
-        for (int i = 0; i < loop.length; ++i) flags[byPosition[i]] |= std::uint8_t(1u << loop.cubeSlot[i]);
+        if (first == v)
+          for (int i = 0; i < loop.triangleCount; ++i) {
+            const auto& tri = loop.triangles[i];
+            triangles.push_back({byPosition[tri[0]], byPosition[tri[1]], byPosition[tri[2]]});
+          }
         continue;
       }
 
       // The strict-26 tube, or a graph that does not match the image (which this reports).
       PatchVertices patchVertices;
       walkPatch(graph, m, config, patch, table, v, patchVertices);
+      std::uint32_t first = v;
+      for (int i = 0; i < patchVertices.count; ++i) {
+        const std::uint32_t u = patchVertices.found[i];
+        first = std::min(first, u);
+        if (inRange(u)) flags[u] |= std::uint8_t(1u << onEdges[config][patchVertices.edgeOfFound[i]].cubeSlot);
+      }
       for (const auto& tri : table.patchTriangles(patch)) {
         const std::int32_t a = patchVertices.onEdge[tri[0]], b = patchVertices.onEdge[tri[1]],
                            c = patchVertices.onEdge[tri[2]];
         if ((a | b | c) < 0) throwUnreachable(t, m, a < 0 ? tri[0] : b < 0 ? tri[1] : tri[2]);
-        mesh.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
-      }
-      for (int i = 0; i < patchVertices.count; ++i) {
-        const int slot = onEdges[config][patchVertices.edgeOfFound[i]].cubeSlot;
-        flags[patchVertices.found[i]] |= std::uint8_t(1u << slot);
+        if (first == v) triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
       }
     }
   }
+}
+
+/// The loop algorithm over all vertices (extractLoopsOf), on `threads` threads (0: all cores)
+/// when findBrick may be called from several at once: runs of vertices walked apart, their
+/// triangles joined in order. The mesh is the same for any number of threads.
+template <class FindBrick>
+TriangleMesh extractLoops(const SurfaceGraph& graph, const BinaryBricks& bricks, FindBrick&& findBrick,
+                          int threads = 1) {
+  const std::vector<Surfel>& surfels = graph.surfels;
+  const std::uint32_t n = std::uint32_t(surfels.size());
+  TriangleMesh mesh;
+  reserveHugePages(mesh.surfels, surfels.size());
+  mesh.surfels.assign(surfels.begin(), surfels.end());
+  std::vector<std::uint8_t> flags(surfels.size(), 0);
+  // Runs of up to 2^14 vertices, about 64 runs at least; left to choose (0), small surfaces
+  // stay on this thread (waking threads would cost more).
+  const std::uint32_t kRun = std::clamp<std::uint32_t>(n / 64, 64, 1u << 14);
+  if (n == 0 || threads == 1 || (threads == 0 && n < (1u << 16))) {
+    reserveHugePages(mesh.triangles, 2 * surfels.size() + 16);
+    extractLoopsOf(graph, bricks, findBrick, 0, n, flags.data(), mesh.triangles);
+    return mesh;
+  }
+  const std::size_t runs = (n + kRun - 1) / kRun;
+  std::vector<std::vector<std::array<std::uint32_t, 3>>> parts(runs);
+  std::vector<std::size_t> start(runs + 1, 0);
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), runs, [&](std::size_t r) {
+      const std::uint32_t begin = std::uint32_t(r * kRun), end = std::min(n, begin + kRun);
+      parts[r].reserve(2 * std::size_t(end - begin) + 16);
+      extractLoopsOf(graph, bricks, findBrick, begin, end, flags.data(), parts[r]);
+    });
+  });
+  for (std::size_t r = 0; r < runs; ++r) start[r + 1] = start[r] + parts[r].size();
+  resizeHugePages(mesh.triangles, start[runs]);
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), runs, [&](std::size_t r) {
+      std::copy(parts[r].begin(), parts[r].end(), mesh.triangles.begin() + std::ptrdiff_t(start[r]));
+      parts[r] = {};
+    });
+  });
   return mesh;
 }
 
@@ -180,7 +233,8 @@ TriangleMesh extractLoops(const BinaryImage& image, const SurfaceGraph& graph) {
 /// the image. Throws std::invalid_argument for a graph that has vertices but no bricks (not made
 /// by trackComponent: use the overload with the image), std::logic_error if the graph does not
 /// match its bricks.
-inline TriangleMesh extractLoops(const SurfaceGraph& graph) {
+/// On `threads` threads (0: all cores), the same mesh for any number.
+inline TriangleMesh extractLoops(const SurfaceGraph& graph, int threads = 1) {
   if (graph.bricks.empty() && graph.surfelCount() != 0)
     throw std::invalid_argument(
         "extractLoops: this surface graph carries no image bricks (it was not made by "
@@ -194,7 +248,7 @@ inline TriangleMesh extractLoops(const SurfaceGraph& graph) {
       throw std::logic_error(msg.str());
     }
     return b;
-  });
+  }, threads);
 }
 
 }  // namespace surftrack

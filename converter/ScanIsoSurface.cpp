@@ -25,6 +25,7 @@
 #include "ConfigurationTable.h"
 #include "DigitalCube.h"
 
+#include <boost/pending/disjoint_sets.hpp>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -86,8 +87,20 @@ class Scanner {
         // Left to choose (0), small images take one thread: waking threads would cost more.
         threads_(threads == 0 && dims.count() < (std::size_t(1) << 18) ? 1 : threads),
         arena_(threads_ > 0 ? threads_ : tbb::task_arena::automatic) {
-    for (int config = 0; config < 256; ++config)
-      table_[config] = &configurationTable(pair, std::uint8_t(config));
+    for (int config = 0; config < 256; ++config) {
+      const CubeTriangulation& table = configurationTable(pair, std::uint8_t(config));
+      table_[config] = &table;
+      std::array<int, CubeTriangulation::kMaxPatches> firstEdge;
+      firstEdge.fill(-1);
+      for (int k = 0; k < 12; ++k) {
+        const int p = table.patchOfEdge[k];
+        if (p < 0) continue;
+        if (firstEdge[p] < 0)
+          firstEdge[p] = k;
+        else
+          joins_[config].edge[joins_[config].count++] = {std::uint8_t(firstEdge[p]), std::uint8_t(k)};
+      }
+    }
     // Valid bits: cubes and x-edges have their low voxel x in [-1, nx - 1]; voxels, y- and
     // z-edges have x in [-1, nx].
     cubeMask_.assign(words_, 0);
@@ -106,63 +119,101 @@ class Scanner {
   }
 
   TriangleMesh run() {
-    // Slab s = z + 1 in [0, nz + 1) is the iteration that numbers the x-, y-edges of plane
-    // z + 1 and the z-edges between z and z + 1, and emits the triangles of its cubes; plane
-    // -1's edges come first of all.
-    const int slabs = dims_.nz + 1;
-    std::vector<std::size_t> vertexStart(slabs + 1), triangleStart(slabs + 1);
-    std::size_t prologue = 0;
-    for (int j = 0; j < rowCount_; ++j) prologue += planeRowCount(-1, j);
-    forEach(0, slabs, [&](int s) {
-      const int z = s - 1;
-      std::size_t v = 0, t = 0;
-      for (int j = 0; j < rowCount_; ++j) {
-        v += planeRowCount(z + 1, j) + slabRowCount(z, j);
-        if (j > 0) t += rowTriangleCount(z, j - 1);
-      }
-      vertexStart[s + 1] = v;
-      triangleStart[s + 1] = t;
-    });
-    vertexStart[0] = prologue;
-    std::partial_sum(vertexStart.begin(), vertexStart.end(), vertexStart.begin());
-    std::partial_sum(triangleStart.begin(), triangleStart.end(), triangleStart.begin());
-    if (vertexStart[slabs] > std::numeric_limits<std::uint32_t>::max())
+    const Layout layout = countSlabs(true);
+    const int slabs = layout.slabs();
+    if (layout.vertexStart[slabs] > std::numeric_limits<std::uint32_t>::max())
       throw std::length_error("scanIsoSurface: more than 2^32 - 1 boundary surfels");
-
     TriangleMesh mesh;
-    mesh.surfels.resize(vertexStart[slabs]);
-    mesh.triangles.resize(triangleStart[slabs]);
-    // Runs of slabs of about equal work; a run re-numbers its first plane's edges itself.
-    const int runs = threads_ == 1 ? 1 : std::min(slabs, 8 * std::max(1, arena_.max_concurrency()));
+    mesh.surfels.resize(layout.vertexStart[slabs]);
+    mesh.triangles.resize(layout.triangleStart[slabs]);
+    const int runs = runCount(slabs);
     forEach(0, runs, [&](int r) {
-      const int first = int(std::int64_t(slabs) * r / runs), last = int(std::int64_t(slabs) * (r + 1) / runs);
-      Run run(*this, mesh);
-      if (first == 0) {
-        run.vertex = 0;
-        for (int j = 0; j < rowCount_; ++j) run.numberPlaneEdges(-1, j, run.bottom, true);
-      } else {
-        // Plane first - 1 was numbered by slab first - 1, row by row between that slab's
-        // z-edges: replay the indices without writing the vertices.
-        run.vertex = std::uint32_t(vertexStart[first - 1]);
-        for (int j = 0; j < rowCount_; ++j) {
-          run.numberPlaneEdges(first - 1, j, run.bottom, false);
-          run.vertex += std::uint32_t(slabRowCount(first - 2, j));
-        }
-      }
-      run.triangle = triangleStart[first];
-      for (int s = first; s < last; ++s) {
-        const int z = s - 1;
-        // Row by row, so that the indices just written are still in cache when read: the
-        // cubes of row j need the edges of rows j and j + 1.
-        for (int j = 0; j < rowCount_; ++j) {
-          run.numberPlaneEdges(z + 1, j, run.top, true);
-          run.numberSlabEdges(z, j);
-          if (j > 0) run.marchRow(z, j - 1);
-        }
-        std::swap(run.bottom, run.top);
-      }
+      const auto [first, last] = runSlabs(r, runs, slabs);
+      MeshOutput output{*this, mesh, layout.triangleStart[first]};
+      Run<MeshOutput> run(*this, output);
+      run.fill(layout, first, last);
     });
     return mesh;
+  }
+
+  /// The boundaries' surfel counts and first vertices, in the order of their first vertex.
+  /// Count, prefix sum, fill as run() does, but a run of slabs joins the vertices of each
+  /// patch of its cubes in a union-find (Boost's disjoint sets, as MeshComponents.h) instead of
+  /// writing triangles; the sets that reach the first or last slab of a run are joined to
+  /// their neighbours' through the vertices the two runs share; then one more pass over the
+  /// vertex numbering picks the surfel of each boundary's first vertex.
+  std::vector<BoundaryCount> countBoundaries() {
+    const Layout layout = countSlabs(false);
+    const int slabs = layout.slabs();
+    if (layout.vertexStart[slabs] > std::numeric_limits<std::uint32_t>::max())
+      throw std::length_error("scanBoundaryCounts: more than 2^32 - 1 boundary surfels");
+    const int runs = runCount(slabs);
+    std::vector<RunSets> sets(runs);
+    forEach(0, runs, [&](int r) {
+      const auto [first, last] = runSlabs(r, runs, slabs);
+      sets[r] = joinRun(layout, first, last, last < slabs);
+    });
+
+    // Sets that cross from run r - 1 into run r: one union-find over all of them, joined at
+    // each vertex of the slab the two runs share.
+    std::vector<std::size_t> openStart(runs + 1, 0);
+    for (int r = 0; r < runs; ++r) openStart[r + 1] = openStart[r] + sets[r].open.size();
+    const std::size_t openCount = openStart[runs];
+    std::vector<std::uint8_t> rank(openCount);
+    std::vector<std::uint32_t> parent(openCount);
+    boost::disjoint_sets<std::uint8_t*, std::uint32_t*> joined(rank.data(), parent.data());
+    for (std::uint32_t i = 0; i < openCount; ++i) joined.make_set(i);
+    for (int r = 1; r < runs; ++r) {
+      const std::vector<std::uint32_t>& below = sets[r - 1].topSet;
+      const std::vector<std::uint32_t>& above = sets[r].bottomSet;
+      for (std::size_t i = 0; i < above.size(); ++i)
+        joined.union_set(std::uint32_t(openStart[r - 1] + below[i]), std::uint32_t(openStart[r] + above[i]));
+    }
+    std::vector<BoundaryCount> crossing;  // by root, then compacted
+    std::vector<std::uint32_t> slot(openCount, kNone);
+    for (int r = 0; r < runs; ++r)
+      for (std::size_t i = 0; i < sets[r].open.size(); ++i) {
+        const std::uint32_t root = joined.find_set(std::uint32_t(openStart[r] + i));
+        if (slot[root] == kNone) {
+          slot[root] = std::uint32_t(crossing.size());
+          crossing.push_back({0, kNoVertex, {}});
+        }
+        BoundaryCount& b = crossing[slot[root]];
+        b.surfels += sets[r].open[i].surfels;
+        b.firstVertex = std::min(b.firstVertex, sets[r].open[i].firstVertex);
+      }
+    // Each crossing boundary goes to the run that holds its first vertex, among the run's own
+    // boundaries in order of first vertex.
+    std::sort(crossing.begin(), crossing.end(),
+              [](const BoundaryCount& a, const BoundaryCount& b) { return a.firstVertex < b.firstVertex; });
+    std::vector<std::size_t> start(runs + 1, 0);
+    std::vector<std::vector<BoundaryCount>> merged(runs);
+    {
+      std::size_t c = 0;
+      for (int r = 0; r < runs; ++r) {
+        const std::uint64_t end = layout.vertexStart[runSlabs(r, runs, slabs).second];
+        std::vector<BoundaryCount>& own = sets[r].closed;
+        std::vector<BoundaryCount>& out = merged[r];
+        out.reserve(own.size());
+        std::size_t k = 0;
+        for (; c < crossing.size() && crossing[c].firstVertex < end; ++c) {
+          for (; k < own.size() && own[k].firstVertex < crossing[c].firstVertex; ++k) out.push_back(own[k]);
+          out.push_back(crossing[c]);
+        }
+        out.insert(out.end(), own.begin() + std::ptrdiff_t(k), own.end());
+        own = {};
+        start[r + 1] = start[r] + out.size();
+      }
+    }
+    std::vector<BoundaryCount> out(start[runs]);
+    forEach(0, runs, [&](int r) {
+      const auto [first, last] = runSlabs(r, runs, slabs);
+      SeedOutput output{merged[r].data(), merged[r].data() + merged[r].size()};
+      Run<SeedOutput> run(*this, output);
+      run.number(layout, first, last);
+      std::copy(merged[r].begin(), merged[r].end(), out.begin() + std::ptrdiff_t(start[r]));
+    });
+    return out;
   }
 
  private:
@@ -222,9 +273,156 @@ class Scanner {
     return Surfel{high, directionOf(axis, -1)};
   }
 
-  /// One thread's run of slabs: its edge-index planes and its cursors into the mesh.
+  static constexpr std::uint32_t kNone = ~std::uint32_t(0);
+  static constexpr std::uint64_t kNoVertex = ~std::uint64_t(0);
+
+  /// Where each slab's vertices and triangles start (slab s = z + 1 in [0, nz + 1) numbers the
+  /// x-, y-edges of plane z + 1 and the z-edges between z and z + 1, and holds the cubes
+  /// between them; plane -1's edges come first of all, before vertexStart[0]).
+  struct Layout {
+    std::vector<std::size_t> vertexStart, triangleStart;
+    int slabs() const { return int(vertexStart.size()) - 1; }
+  };
+
+  /// The count pass (triangles only if asked), and its prefix sums.
+  Layout countSlabs(bool triangles) {
+    const int slabs = dims_.nz + 1;
+    Layout layout{std::vector<std::size_t>(slabs + 1), std::vector<std::size_t>(slabs + 1)};
+    std::size_t prologue = 0;
+    for (int j = 0; j < rowCount_; ++j) prologue += planeRowCount(-1, j);
+    forEach(0, slabs, [&](int s) {
+      const int z = s - 1;
+      std::size_t v = 0, t = 0;
+      for (int j = 0; j < rowCount_; ++j) {
+        v += planeRowCount(z + 1, j) + slabRowCount(z, j);
+        if (triangles && j > 0) t += rowTriangleCount(z, j - 1);
+      }
+      layout.vertexStart[s + 1] = v;
+      layout.triangleStart[s + 1] = t;
+    });
+    layout.vertexStart[0] = prologue;
+    std::partial_sum(layout.vertexStart.begin(), layout.vertexStart.end(), layout.vertexStart.begin());
+    std::partial_sum(layout.triangleStart.begin(), layout.triangleStart.end(), layout.triangleStart.begin());
+    return layout;
+  }
+
+  /// Runs of slabs of about equal work, several per thread; one on one thread.
+  int runCount(int slabs) const {
+    return threads_ == 1 ? 1 : std::min(slabs, 8 * std::max(1, arena_.max_concurrency()));
+  }
+  static std::pair<int, int> runSlabs(int r, int runs, int slabs) {
+    return {int(std::int64_t(slabs) * r / runs), int(std::int64_t(slabs) * (r + 1) / runs)};
+  }
+
+  /// Writes the vertices and triangles of a run into the mesh.
+  struct MeshOutput {
+    const Scanner& s;
+    TriangleMesh& mesh;
+    std::size_t triangle;
+    void vertex(std::uint32_t v, const Surfel& surfel) { mesh.surfels[v] = surfel; }
+    void cube(unsigned config, const std::array<const std::uint32_t*, 12>& edge, int i) {
+      for (const auto& t : s.table_[config]->allTriangles())
+        mesh.triangles[triangle++] = {edge[t[0]][i], edge[t[1]][i], edge[t[2]][i]};
+    }
+  };
+
+  /// Joins the vertices of each patch of a run's cubes; vertex v is element v - base.
+  struct UnionOutput {
+    const Scanner& s;
+    boost::disjoint_sets<std::uint8_t*, std::uint32_t*>& sets;
+    std::uint32_t base;
+    void vertex(std::uint32_t, const Surfel&) {}
+    void cube(unsigned config, const std::array<const std::uint32_t*, 12>& edge, int i) {
+      // The root of a patch's first edge is found once for the patch's other edges.
+      const PatchJoins& joins = s.joins_[config];
+      int first = -1;
+      std::uint32_t root = 0;
+      for (int k = 0; k < joins.count; ++k) {
+        if (joins.edge[k][0] != first) {
+          first = joins.edge[k][0];
+          root = sets.find_set(edge[first][i] - base);
+        }
+        const std::uint32_t other = sets.find_set(edge[joins.edge[k][1]][i] - base);
+        if (other != root) {
+          sets.link(root, other);
+          root = sets.find_set(root);
+        }
+      }
+    }
+  };
+
+  /// Picks the surfels of the vertices `next` .. `end` ask for (in increasing order).
+  struct SeedOutput {
+    BoundaryCount* next;
+    BoundaryCount* end;
+    void vertex(std::uint32_t v, const Surfel& surfel) {
+      if (next != end && next->firstVertex == v) (next++)->seed = surfel;
+    }
+  };
+
+  /// What one run of slabs found: its boundaries that lie in its slabs alone ("closed", in
+  /// order of first vertex), those that may go on into the run below or above ("open"), and
+  /// the open set of each vertex of the slab shared with the run below (the slab before its
+  /// first: bottomSet) and of its own last slab, which the run above shares (topSet).
+  struct RunSets {
+    std::vector<BoundaryCount> closed, open;
+    std::vector<std::uint32_t> bottomSet, topSet;
+  };
+
+  RunSets joinRun(const Layout& layout, int first, int last, bool sharesTop) const {
+    const std::size_t base = first == 0 ? 0 : layout.vertexStart[first - 1];
+    const std::size_t own = first == 0 ? 0 : layout.vertexStart[first];
+    const std::size_t top = sharesTop ? layout.vertexStart[last - 1] : layout.vertexStart[last];
+    const std::size_t end = layout.vertexStart[last], n = end - base;
+    std::vector<std::uint8_t> rank(n);
+    std::vector<std::uint32_t> parent(n);
+    boost::disjoint_sets<std::uint8_t*, std::uint32_t*> sets(rank.data(), parent.data());
+    for (std::uint32_t v = 0; v < n; ++v) sets.make_set(v);
+    UnionOutput output{*this, sets, std::uint32_t(base)};
+    Run<UnionOutput> run(*this, output);
+    run.fill(layout, first, last);
+
+    // Every vertex's root (full path compression: parent[v] is its root afterwards); the sets
+    // are numbered in order of their first vertex, open ones (bit 31) those with a vertex in a
+    // shared slab.
+    for (std::uint32_t v = 0; v < n; ++v) parent[v] = sets.find_set(v);
+    constexpr std::uint32_t kOpen = std::uint32_t(1) << 31;
+    std::vector<std::uint32_t> number(n, kNone);
+    RunSets out;
+    auto markOpen = [&](std::size_t from, std::size_t to) {
+      for (std::size_t g = from; g < to; ++g) {
+        std::uint32_t& k = number[parent[g - base]];
+        if (k == kNone) {
+          k = kOpen | std::uint32_t(out.open.size());
+          out.open.push_back({0, kNoVertex, {}});
+        }
+      }
+    };
+    markOpen(base, own);
+    markOpen(top, end);
+    for (std::size_t g = base; g < end; ++g) {
+      std::uint32_t& k = number[parent[g - base]];
+      if (k == kNone) {
+        k = std::uint32_t(out.closed.size());
+        out.closed.push_back({0, g, {}});
+      }
+      if (g < own) continue;  // the run below's vertex
+      BoundaryCount& b = k & kOpen ? out.open[k & ~kOpen] : out.closed[k];
+      ++b.surfels;
+      b.firstVertex = std::min<std::uint64_t>(b.firstVertex, g);
+    }
+    auto setOf = [&](std::size_t g) { return number[parent[g - base]] & ~kOpen; };
+    out.bottomSet.reserve(own - base);
+    for (std::size_t g = base; g < own; ++g) out.bottomSet.push_back(setOf(g));
+    if (sharesTop)
+      for (std::size_t g = top; g < end; ++g) out.topSet.push_back(setOf(g));
+    return out;
+  }
+
+  /// One thread's run of slabs: its edge-index planes and its cursor into the vertices.
+  template <class Output>
   struct Run {
-    Run(const Scanner& scanner, TriangleMesh& mesh) : s(scanner), mesh(mesh) {
+    Run(const Scanner& scanner, Output& output) : s(scanner), out(output) {
       for (PlaneEdges* p : {&bottom, &top}) {
         p->x.assign(std::size_t(s.rowCount_) * s.columns_, 0);
         p->y.assign(std::size_t(s.rowCount_) * s.columns_, 0);
@@ -232,8 +430,52 @@ class Scanner {
       zEdge.assign(2 * s.columns_, 0);
     }
 
+    /// Numbers the vertices of slabs [first, last) and visits their cubes (a run re-numbers
+    /// its first plane's edges itself).
+    void fill(const Layout& layout, int first, int last) {
+      start(layout, first);
+      for (int sl = first; sl < last; ++sl) {
+        const int z = sl - 1;
+        // Row by row, so that the indices just written are still in cache when read: the
+        // cubes of row j need the edges of rows j and j + 1.
+        for (int j = 0; j < s.rowCount_; ++j) {
+          numberPlaneEdges(z + 1, j, top, true);
+          numberSlabEdges(z, j);
+          if (j > 0) marchRow(z, j - 1);
+        }
+        std::swap(bottom, top);
+      }
+    }
+
+    /// Numbers the vertices of slabs [first, last) only.
+    void number(const Layout& layout, int first, int last) {
+      vertex = first == 0 ? 0 : std::uint32_t(layout.vertexStart[first]);
+      if (first == 0)
+        for (int j = 0; j < s.rowCount_; ++j) numberPlaneEdges(-1, j, bottom, true);
+      for (int sl = first; sl < last; ++sl)
+        for (int j = 0; j < s.rowCount_; ++j) {
+          numberPlaneEdges(sl, j, top, true);
+          numberSlabEdges(sl - 1, j);
+        }
+    }
+
+    void start(const Layout& layout, int first) {
+      if (first == 0) {
+        vertex = 0;
+        for (int j = 0; j < s.rowCount_; ++j) numberPlaneEdges(-1, j, bottom, true);
+        return;
+      }
+      // Plane first - 1 was numbered by slab first - 1, row by row between that slab's
+      // z-edges: replay the indices without writing the vertices.
+      vertex = std::uint32_t(layout.vertexStart[first - 1]);
+      for (int j = 0; j < s.rowCount_; ++j) {
+        numberPlaneEdges(first - 1, j, bottom, false);
+        vertex += std::uint32_t(s.slabRowCount(first - 2, j));
+      }
+    }
+
     std::uint32_t addVertex(const Surfel& surfel, bool write) {
-      if (write) mesh.surfels[vertex] = surfel;
+      if (write) out.vertex(vertex, surfel);
       return vertex++;
     }
 
@@ -269,8 +511,8 @@ class Scanner {
         });
     }
 
-    /// Emits the triangles of every non-trivial cube with min corner y = j - 1 in the slab
-    /// between planes z and z + 1.
+    /// Hands every non-trivial cube with min corner y = j - 1 in the slab between planes z and
+    /// z + 1 to the output, with the vertex indices of its 12 edges.
     void marchRow(int z, int j) {
       // Corner rows: r[c] holds the corners with y-bit c & 1 and z-bit c >> 1.
       const std::uint64_t* const r[4] = {s.row(z, j), s.row(z, j + 1), s.row(z + 1, j), s.row(z + 1, j + 1)};
@@ -285,19 +527,22 @@ class Scanner {
           zEdge.data() + zAt,    zEdge.data() + zAt + 1,     // z-edges: x-bit, y-bit
           zEdge.data() + zAbove, zEdge.data() + zAbove + 1};
       for (int w = 0; w < s.words_ - 1; ++w)
-        forEachBit(mixedCubes(r[0], r[1], r[2], r[3], w) & s.cubeMask_[w], w, [&](int b) {
-          const int i = b - kRowOffset + 1;
-          for (const auto& t : s.table_[s.cubeConfig(r, b)]->allTriangles())
-            mesh.triangles[triangle++] = {edge[t[0]][i], edge[t[1]][i], edge[t[2]][i]};
-        });
+        forEachBit(mixedCubes(r[0], r[1], r[2], r[3], w) & s.cubeMask_[w], w,
+                   [&](int b) { out.cube(s.cubeConfig(r, b), edge, b - kRowOffset + 1); });
     }
 
     const Scanner& s;
-    TriangleMesh& mesh;
+    Output& out;
     PlaneEdges bottom, top;             // planes z and z + 1 of the current slab
     std::vector<std::uint32_t> zEdge;   // z-edges of the slab, rows j and j + 1 at j & 1
     std::uint32_t vertex = 0;
-    std::size_t triangle = 0;
+  };
+
+  /// The vertex pairs of each configuration whose union joins the vertices of each patch
+  /// (every cut edge to the first cut edge of its patch).
+  struct PatchJoins {
+    std::uint8_t count = 0;
+    std::array<std::array<std::uint8_t, 2>, 12> edge{};
   };
 
   Dims dims_;
@@ -307,6 +552,7 @@ class Scanner {
   int threads_;
   tbb::task_arena arena_;
   std::array<const CubeTriangulation*, 256> table_{};
+  std::array<PatchJoins, 256> joins_{};
   std::vector<std::uint64_t> cubeMask_, voxelMask_;
   std::vector<std::uint64_t> bits_;  // planes z = -1 .. nz of rowCount_ rows of words_ words
 };
@@ -316,6 +562,11 @@ class Scanner {
 TriangleMesh scanRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows, int threads) {
   if (dims.empty()) return {};
   return Scanner(dims, pair, rows, threads).run();
+}
+
+std::vector<BoundaryCount> countRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows, int threads) {
+  if (dims.empty()) return {};
+  return Scanner(dims, pair, rows, threads).countBoundaries();
 }
 
 }  // namespace scan

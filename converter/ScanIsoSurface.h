@@ -12,6 +12,9 @@
 //  - Vertices are shared between cubes without a global hash map (as in flying edges and
 //    OpenVDB's VolumeToMesh): before the cubes of a slab z..z+1 are visited, every cut grid edge
 //    of the slab gets its vertex index in small per-plane arrays indexed by edge position.
+//  - scanBoundaryCounts runs the same slabs but, instead of writing triangles, joins the
+//    surfels of each cube's patches in a union-find (Boost's disjoint sets): every boundary's
+//    surfel count and first surfel, for `--largest`, with no mesh built.
 //  - A dense ThresholdImage (any gray type, in particular the binaryView of a BinaryVolume) is
 //    binarised straight from its buffer, 16 uint8 voxels per SSE2 instruction; any other binary
 //    image (LabelImage, ImplicitImage, ...) is read through its operator().
@@ -36,6 +39,13 @@
 
 namespace surftrack {
 
+/// One kappa-lambda-boundary of a scanned image, as a component of the scanned mesh.
+struct BoundaryCount {
+  std::size_t surfels = 0;       ///< its number of surfels
+  std::uint64_t firstVertex = 0;  ///< its first vertex in the scanned mesh (scanRows' numbering)
+  Surfel seed;                    ///< the surfel of that vertex
+};
+
 namespace scan {
 
 /// In a row bit set, voxel x (for x in [-1, nx]) is bit x + kRowOffset: the voxels of the
@@ -58,6 +68,11 @@ class RowSource {
 /// describes on the domain `dims` (cubes with min corner in [-1, n - 1] on each axis), on
 /// `threads` threads (0: all cores). The mesh is the same for any number of threads.
 TriangleMesh scanRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows, int threads = 0);
+
+/// Every kappa-lambda-boundary of the binary image that `rows` describes, without a triangle:
+/// its surfel count and its first surfel, in the order of meshComponents on the mesh scanRows
+/// would give (that of their first vertex). Same for any number of threads.
+std::vector<BoundaryCount> countRows(const Dims& dims, AdjacencyPair pair, const RowSource& rows, int threads = 0);
 
 /// Rows of any binary image, one operator() call per voxel.
 template <class BinaryImage>
@@ -135,6 +150,19 @@ TriangleMesh scanIsoSurface(const BinaryImage& image, AdjacencyPair pair, int th
     return scan::scanRows(image.dims(), pair, scan::WordRows<BinaryImage>(image), threads);
   else
     return scanIsoSurfaceGeneric(image, pair, threads);
+}
+
+/// Every kappa-lambda-boundary of a whole binary image with its surfel count and one surfel
+/// of it, without building the iso-surface: what meshComponents tells of scanIsoSurface's
+/// mesh (the same boundaries, in the same order, each with its first vertex), from a scan that
+/// joins the surfels of each cube's patches in a union-find instead of writing triangles. On
+/// `threads` threads (0: all cores), the same result for any number.
+template <class BinaryImage>
+std::vector<BoundaryCount> scanBoundaryCounts(const BinaryImage& image, AdjacencyPair pair, int threads = 0) {
+  if constexpr (scan::RowReadable<BinaryImage>)
+    return scan::countRows(image.dims(), pair, scan::WordRows<BinaryImage>(image), threads);
+  else
+    return scan::countRows(image.dims(), pair, scan::GenericRows<BinaryImage>(image), threads);
 }
 
 /// Connected components of a mesh's triangles through shared vertices: returns the component

@@ -344,3 +344,41 @@ TEST(FrontDoor, TheSpeckWarningFiresOnASpeckAndNotOnTheBall) {
 }
 
 }  // namespace
+
+// --threads: the scan of `largest`, the tracker's second pass, the loop extraction and the
+// placement split their work; the surface is the same for 1, 2 and 7 threads, and `largest` is
+// the boundary of most surfels (the first met among equals) of the full scan.
+TEST(FrontDoor, EveryThreadCountGivesTheSameSurface) {
+  for (unsigned noise : {3u, 4u}) {
+    const Dims d{61, 57, 66};
+    const std::vector<std::uint8_t> ref = noisyBall<std::uint8_t>(d, 22, noise);
+    ExtractOptions o;
+    o.selection = Selection::threshold(60.5);
+    o.seed = SeedRule::all();
+    o.threads = 1;
+    const Surface all = extract(VolumeView::of(ref.data(), d), o);
+    std::size_t most = 0;
+    for (const ComponentFigures& c : all.components) most = std::max(most, c.surfels);
+    ASSERT_GT(all.components.size(), 2u);
+    for (Mapping mapping : {Mapping::Linear, Mapping::Midpoint}) {
+      o.mapping = mapping;
+      o.seed = SeedRule::largest();
+      o.threads = 1;
+      const Surface one = extract(VolumeView::of(ref.data(), d), o);
+      EXPECT_EQ(one.surfels.size(), most);
+      EXPECT_EQ(one.boundariesInImage, all.components.size());
+      ExtractOptions seeded = o;
+      seeded.seed = SeedRule::fromSurfel(*one.seed.surfel);
+      for (int threads : {2, 7}) {
+        o.threads = seeded.threads = threads;
+        for (const ExtractOptions& options : {o, seeded}) {
+          const Surface many = extract(VolumeView::of(ref.data(), d), options);
+          EXPECT_EQ(many.seed.surfel, one.seed.surfel) << "threads " << threads;
+          EXPECT_EQ(many.surfels, one.surfels) << "threads " << threads;
+          EXPECT_EQ(many.triangles, one.triangles) << "threads " << threads;
+          EXPECT_EQ(many.vertices, one.vertices) << "threads " << threads;
+        }
+      }
+    }
+  }
+}

@@ -375,3 +375,86 @@ TEST(ScanIsoSurface, NoisySphereOfTheProtocol) {
   EXPECT_NEAR(double(hits) / noisy.hit.size(), 0.05, 0.002);
   EXPECT_NEAR(double(white) / hits, 0.5, 0.02);
 }
+
+namespace {
+
+/// scanBoundaryCounts against the components of the scanned mesh: the same boundaries in the
+/// same order, each with its surfel count, its first vertex and that vertex's surfel; on one
+/// thread and, when `threaded`, on 2 and 7 (a run per slab or a few, so that boundaries cross
+/// between runs). With `withVoxelComponents`, the counts are also those of the independent
+/// voxel components.
+template <class BinaryImage>
+void expectCountsAreComponents(const BinaryImage& image, AdjacencyPair pair, bool withVoxelComponents,
+                               const char* what, bool threaded = true) {
+  const TriangleMesh mesh = scanIsoSurface(image, pair, 1);
+  std::size_t count = 0;
+  const std::vector<std::uint32_t> label = meshComponents(mesh, count);
+  std::vector<BoundaryCount> expected(count);
+  std::vector<bool> seen(count, false);
+  for (std::size_t v = 0; v < label.size(); ++v) {
+    BoundaryCount& b = expected[label[v]];
+    ++b.surfels;
+    if (!seen[label[v]]) {
+      seen[label[v]] = true;
+      b.firstVertex = v;
+      b.seed = mesh.surfels[v];
+    }
+  }
+  for (int threads : {1, 2, 7}) {
+    if (threads > 1 && !threaded) break;
+    const std::vector<BoundaryCount> counts = scanBoundaryCounts(image, pair, threads);
+    ASSERT_EQ(counts.size(), expected.size()) << what << " " << toString(pair) << " threads " << threads;
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+      ASSERT_EQ(counts[i].surfels, expected[i].surfels) << what << " " << toString(pair) << " threads " << threads;
+      ASSERT_EQ(counts[i].firstVertex, expected[i].firstVertex) << what << " " << toString(pair) << " threads " << threads;
+      ASSERT_EQ(counts[i].seed, expected[i].seed) << what << " " << toString(pair) << " threads " << threads;
+    }
+  }
+  if (!withVoxelComponents) return;
+  // Independently: each boundary of the voxel components holds exactly one seed, and has its size.
+  std::map<std::uint64_t, std::size_t> sizeOfSeed;
+  for (const BoundaryCount& b : expected) sizeOfSeed[b.seed.key()] = b.surfels;
+  std::size_t boundaries = 0;
+  for (auto& [oq, keys] : surftrack::testing::VoxelComponents(image, pair).boundaries()) {
+    ++boundaries;
+    std::size_t seeds = 0;
+    for (std::uint64_t k : keys)
+      if (auto it = sizeOfSeed.find(k); it != sizeOfSeed.end()) {
+        ++seeds;
+        EXPECT_EQ(it->second, keys.size()) << what << " " << toString(pair);
+      }
+    EXPECT_EQ(seeds, 1u) << what << " " << toString(pair);
+  }
+  EXPECT_EQ(boundaries, expected.size()) << what << " " << toString(pair);
+}
+
+}  // namespace
+
+TEST(ScanBoundaryCounts, AreTheScannedComponentsOnEvery2x2x2And2x2x3Image) {
+  for (AdjacencyPair pair : kAllAdjacencyPairs)
+    for (Dims d : {Dims{2, 2, 2}, Dims{2, 2, 3}})
+      for (const BinaryVolume& v : allImages(d))
+        ASSERT_NO_FATAL_FAILURE(
+            expectCountsAreComponents(binaryView(v), pair, d.nz == 2, "small", v.data()[0] + 2 * v.data()[5] == 3));
+}
+
+TEST(ScanBoundaryCounts, AreTheScannedComponentsOnRandomImagesForEveryThreadCount) {
+  const std::vector<BinaryVolume> images = randomImages(1000, 4048);
+  for (AdjacencyPair pair : kAllAdjacencyPairs) {
+    for (std::size_t i = 0; i < images.size(); ++i)
+      ASSERT_NO_FATAL_FAILURE(
+          expectCountsAreComponents(binaryView(images[i]), pair, i % 10 == 0, "random", i % 4 == 0));
+    for (Dims d : kWordBoundaryDims) {
+      const BinaryVolume v = randomVolume(d, 0.5, 17 + d.nx);
+      ASSERT_NO_FATAL_FAILURE(expectCountsAreComponents(binaryView(v), pair, true, "word boundaries"));
+      ASSERT_NO_FATAL_FAILURE(expectCountsAreComponents(binaryView(v, /*outside=*/true), pair, false, "outside is 1"));
+    }
+    const NoisyPhantom sphere = makeNoisySphere(48, 0.05, 9);
+    ASSERT_NO_FATAL_FAILURE(expectCountsAreComponents(sphere.binary(), pair, false, "sphere"));
+  }
+  // The generic path (operator() only) and an empty image.
+  const BinaryVolume labels = randomVolume({20, 9, 7}, 0.5, 1);
+  ASSERT_NO_FATAL_FAILURE(
+      expectCountsAreComponents(LabelImage<std::uint8_t>(labels, 0), AdjacencyPair::k26_6, true, "label image"));
+  EXPECT_TRUE(scanBoundaryCounts(binaryView(BinaryVolume({5, 4, 3}, 0)), AdjacencyPair::k6_26, 2).empty());
+}

@@ -1,4 +1,5 @@
-// trackComponent on images that cannot be scanned, its errors, and the seed finder.
+// trackComponent on images that cannot be scanned, its errors, and the seed finder; the graph
+// and its mesh (extractLoops) the same for any number of threads.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <boost/range/iterator_range.hpp>
 
 #include "FindSeed.h"
+#include "LoopExtraction.h"
 #include "Phantoms.h"
 #include "TrackComponent.h"
 #include "VoxelComponents.h"
@@ -123,6 +125,44 @@ TEST(SurfaceGraph, ArcsAreSymmetricAndMatchTheNeighbours) {
     for (auto w : boost::make_iterator_range(boost::adjacent_vertices(v, g.graph)))
       ASSERT_EQ(g.surfels[w], nb[j++]);
   }
+}
+
+
+// The second pass of tracking and the loop extraction in runs of bricks / vertices: the graph
+// (vertex order, arcs) and the mesh (triangle order included) do not depend on the number of
+// threads, and the mesh is that of the one-thread walk over the image (extractLoops(image,
+// graph), which reads the image again instead of the tracker's bricks).
+TEST(Tracking, EveryThreadCountGivesTheSameGraphAndMesh) {
+  auto check = [](const auto& image, const Surfel& seed, AdjacencyPair pair, const std::string& what) {
+    const SurfaceGraph one = trackComponent(image, seed, pair, {}, 1);
+    const TriangleMesh reference = extractLoops(image, one);
+    ASSERT_EQ(extractLoops(one, 1).triangles, reference.triangles) << what;
+    for (int threads : {2, 7, 0}) {
+      const SurfaceGraph many = trackComponent(image, seed, pair, {}, threads);
+      ASSERT_EQ(many.surfels, one.surfels) << what << " threads " << threads;
+      ASSERT_EQ(many.graph.m_forward.m_rowstart, one.graph.m_forward.m_rowstart) << what << " threads " << threads;
+      ASSERT_EQ(many.graph.m_forward.m_column, one.graph.m_forward.m_column) << what << " threads " << threads;
+      const TriangleMesh mesh = extractLoops(many, threads);
+      ASSERT_EQ(mesh.surfels, reference.surfels) << what << " threads " << threads;
+      ASSERT_EQ(mesh.triangles, reference.triangles) << what << " threads " << threads;
+    }
+  };
+  for (AdjacencyPair pair : kAllAdjacencyPairs) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      // 5 % noise: 26-configurations and tubes on the sphere, noise specks touching it.
+      const NoisyPhantom sphere = makeNoisySphere(40 + 8 * int(seed), 0.05, seed);
+      check(sphere.binary(), protocolSeed(sphere), pair, "sphere " + std::to_string(seed) + " " + toString(pair));
+    }
+    for (std::uint32_t seed = 0; seed < 12; ++seed) {
+      const BinaryVolume volume = randomVolume({24, 20, 22}, 0.3 + 0.03 * seed, 500 + seed);
+      const auto image = binaryView(volume);
+      const auto s = seedAlongRay(image, Voxel{0, 10, 11}, 0);
+      if (s) check(image, *s, pair, "random " + std::to_string(seed) + " " + toString(pair));
+    }
+  }
+  // A graph of more than 2^16 surfels, which all cores (0) also split.
+  const NoisyPhantom big = makeNoisySphere(160, 0.01, 4);
+  check(big.binary(), protocolSeed(big), AdjacencyPair::k26_6, "sphere 160");
 }
 
 }  // namespace

@@ -48,6 +48,10 @@ class BinaryBrickCache {
     return l;
   }
 
+  /// linkedBrick(b, s) for a link made before: reads only, so it may be called from several
+  /// threads at once (the tracker's second pass follows the links of its first).
+  std::uint32_t knownLink(std::uint32_t b, int s) const { return links_[b][s]; }
+
   /// The index of the brick that contains voxel v.
   std::uint32_t brickOf(Voxel v) { return brickIndex(v.x >> 3, v.y >> 3, v.z >> 3); }
 

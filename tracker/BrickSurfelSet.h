@@ -54,13 +54,22 @@ class BrickSurfelSet {
     return prefix_[brick][bit >> 6] + std::uint32_t(std::popcount(words_[brick][bit >> 6] & below));
   }
 
+  /// The bricks in numbering order (after number()).
+  const std::vector<std::uint32_t>& order() const { return order_; }
+  /// The vertex index of the first marked surfel of a brick (after number()).
+  std::uint32_t firstIndex(std::uint32_t brick) const { return prefix_[brick][0]; }
+
+  /// Calls f(brick, bit) for every marked surfel of one brick, in index order.
+  template <class F>
+  void forEachIn(std::uint32_t b, F&& f) const {
+    for (int w = 0; w < kWords; ++w)
+      for (std::uint64_t bits = words_[b][w]; bits; bits &= bits - 1) f(b, w * 64 + std::countr_zero(bits));
+  }
+
   /// Calls f(brick, bit) for every marked surfel, in index order (after number()).
   template <class F>
   void forEach(F&& f) const {
-    for (std::uint32_t b : order_)
-      for (int w = 0; w < kWords; ++w)
-        for (std::uint64_t bits = words_[b][w]; bits; bits &= bits - 1)
-          f(b, w * 64 + std::countr_zero(bits));
+    for (std::uint32_t b : order_) forEachIn(b, f);
   }
 
  private:

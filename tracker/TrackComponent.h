@@ -5,6 +5,7 @@
 // images far too large to store.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <functional>
@@ -23,6 +24,9 @@
 #include "HugePages.h"
 #include "Image.h"
 #include "SurfaceGraph.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace surftrack {
 
@@ -103,17 +107,21 @@ template <class Cache, class F>
 /// the order of betaNeighbours (see SurfaceGraph.h).
 ///
 /// Two passes over the surface, both local to a brick and its neighbours (BrickStepTable.h):
-/// a breadth-first traversal marks the surfels of Sigma in per-brick bitmaps; then, brick by
-/// brick, each marked surfel's beta-neighbours are found again and written as vertex indices,
-/// which are ranks in the bitmaps. Recomputing a neighbour costs less than storing and
-/// re-reading it.
+/// a breadth-first traversal marks the surfels of Sigma in per-brick bitmaps and counts the
+/// arcs leaving each brick; then, brick by brick, each marked surfel's beta-neighbours are
+/// found again and written as vertex indices, which are ranks in the bitmaps. Recomputing a
+/// neighbour costs less than storing and re-reading it. The second pass only reads (the bricks
+/// and their links all exist after the first), and each brick's first vertex and first arc are
+/// known from the bitmaps' ranks and the prefix sums of the arc counts, so runs of bricks are
+/// written on `threads` threads (0: all cores) at once; the graph is the same for any number.
 template <class BinaryImage>
 SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, AdjacencyPair pair,
-                            const TrackingProgress& progress = {}) {
+                            const TrackingProgress& progress = {}, int threads = 1) {
   requireTrackableSeed(image, seed);
   BinaryBrickCache<BinaryImage> cache(image);
   const BrickStepTable steps(pair);
   BrickSurfelSet visited;
+  std::vector<std::uint32_t> arcsOfBrick;  // out-arcs of the surfels of each brick
 
   // 1. Breadth-first traversal of beta-arcs from the seed; queue entries are brick << 12 | slot.
   std::size_t arcs = 0;
@@ -130,12 +138,16 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
       queue.reserve(kMaxBetaNeighbours);
       visited.resize(cache.bricks().size() + detail::kMaxBricksCreatedPerSurfel);
       const std::uint64_t entry = queue.pop();
+      const std::uint32_t from = std::uint32_t(entry >> 12);
+      std::uint32_t out = 0;
       detail::forEachBetaNeighbour(
-          cache, steps, std::uint32_t(entry >> 12), int(entry & 4095),
-          [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE {
-            ++arcs;
+          cache, steps, from, int(entry & 4095), [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE {
+            ++out;
             queue.pushIf(std::uint64_t(to) << 12 | std::uint64_t(toSlot), visited.insert(to, toSlot));
           });
+      if (from >= arcsOfBrick.size()) arcsOfBrick.resize(std::size_t(from) + 1, 0);
+      arcsOfBrick[from] += out;
+      arcs += out;
       if (progress && queue.pushed() >= nextReport) {
         progress(queue.pushed());
         nextReport += std::size_t(1) << 20;
@@ -143,24 +155,57 @@ SurfaceGraph trackComponent(const BinaryImage& image, const Surfel& seed, Adjace
     }
   }
 
-  // 2. Vertices by rank, arcs by recomputing each vertex's neighbours.
+  // 2. Vertices by rank, arcs by recomputing each vertex's neighbours, in runs of bricks.
   const std::uint32_t count = visited.number(cache.bricks().bricksInSpaceOrder());
+  const std::vector<std::uint32_t>& order = visited.order();
+  arcsOfBrick.resize(cache.bricks().size(), 0);
   SurfaceGraph result;
   result.pair = pair;
   resizeHugePages(result.surfels, count);
   std::vector<std::uint32_t> rowStart, targets;
   resizeHugePages(rowStart, std::size_t(count) + 1);
   resizeHugePages(targets, arcs);
-  std::uint32_t v = 0, a = 0;
-  visited.forEach([&](std::uint32_t brick, int slot) SURFTRACK_INLINE {
-    const int voxel = slot & 511;
-    result.surfels[v] = Surfel{cache.bricks().brickOrigin(brick) + Voxel{voxel & 7, (voxel >> 3) & 7, voxel >> 6},
-                               Direction(slot >> 9)};
-    detail::forEachBetaNeighbour(
-        cache, steps, brick, slot,
-        [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE { targets[a++] = visited.index(to, toSlot); });
-    rowStart[++v] = a;
-  });
+  // firstArc[i]: the first arc of brick order[i]'s surfels.
+  std::vector<std::size_t> firstArc(order.size() + 1, 0);
+  for (std::size_t i = 0; i < order.size(); ++i) firstArc[i + 1] = firstArc[i] + arcsOfBrick[order[i]];
+  // The links and bricks only read from here on: knownLink instead of linkedBrick.
+  struct FrozenCache {
+    const BinaryBrickCache<BinaryImage>& cache;
+    NeighbourhoodSlices neighbourhoodSlices(std::uint32_t b, int voxel) const {
+      return cache.neighbourhoodSlices(b, voxel);
+    }
+    std::uint32_t linkedBrick(std::uint32_t b, int s) const { return cache.knownLink(b, s); }
+  };
+  const FrozenCache frozen{cache};
+  auto writeBricks = [&](std::size_t begin, std::size_t end) {
+    if (begin == end) return;
+    FrozenCache links = frozen;
+    std::uint32_t v = visited.firstIndex(order[begin]);
+    std::size_t a = firstArc[begin];
+    for (std::size_t i = begin; i < end; ++i)
+      visited.forEachIn(order[i], [&](std::uint32_t brick, int slot) SURFTRACK_INLINE {
+        const int voxel = slot & 511;
+        result.surfels[v] = Surfel{cache.bricks().brickOrigin(brick) + Voxel{voxel & 7, (voxel >> 3) & 7, voxel >> 6},
+                                   Direction(slot >> 9)};
+        detail::forEachBetaNeighbour(links, steps, brick, slot, [&](std::uint32_t to, int toSlot) SURFTRACK_INLINE {
+          targets[a++] = visited.index(to, toSlot);
+        });
+        rowStart[++v] = std::uint32_t(a);
+      });
+  };
+  // Runs of up to 64 bricks, about 64 runs at least; left to choose (0), small surfaces stay on
+  // this thread (waking threads would cost more).
+  const std::size_t kRun = std::clamp<std::size_t>(order.size() / 64, 1, 64);
+  if (threads == 1 || (threads == 0 && count < (1u << 16))) {
+    writeBricks(0, order.size());
+  } else {
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+      tbb::parallel_for(std::size_t(0), (order.size() + kRun - 1) / kRun, [&](std::size_t r) {
+        writeBricks(r * kRun, std::min(order.size(), (r + 1) * kRun));
+      });
+    });
+  }
   result.graph = makeSurfelGraph(std::move(rowStart), std::move(targets));
   result.bricks = std::move(cache).release();
   return result;

@@ -17,6 +17,9 @@
 #include "SourceImage.h"
 #include "TrackComponent.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 namespace surftrack {
 
 std::string toString(Mapping mapping) {
@@ -138,30 +141,31 @@ Surfel resolveSurfelSeed(const SourceImage& binary, const Surfel& s) {
 
 }  // namespace
 
-/// Vertex positions in index space by the boundary mapping (paper §3.1); the linear one reads
-/// the gray values of both voxels of each surfel, in one batch, from the source.
-static std::vector<std::array<double, 3>> placeVertices(const VoxelSource& source, const TriangleMesh& mesh,
-                                                 Mapping mapping, const Selection& selection,
-                                                 double epsilon) {
-  const std::size_t n = mesh.surfels.size();
-  std::vector<std::array<double, 3>> points(n);
+/// Vertex positions of surfels [begin, end) in index space by the boundary mapping (paper
+/// §3.1); the linear one reads the gray values of both voxels of each surfel, in one batch, from
+/// the source.
+static void placeVertices(const VoxelSource& source, const std::vector<Surfel>& surfels, Mapping mapping,
+                          const Selection& selection, double epsilon, std::size_t begin, std::size_t end,
+                          std::array<double, 3>* points) {
   if (mapping == Mapping::Midpoint) {
-    for (std::size_t v = 0; v < n; ++v) points[v] = MidpointMapping{}(mesh.surfels[v]);
-    return points;
+    for (std::size_t v = begin; v < end; ++v) points[v] = MidpointMapping{}(surfels[v]);
+    return;
   }
   const Dims dims = source.dims();
   std::vector<Voxel> voxels;
-  voxels.reserve(2 * n);
-  for (const Surfel& s : mesh.surfels)
+  voxels.reserve(2 * (end - begin));
+  for (std::size_t v = begin; v < end; ++v) {
+    const Surfel& s = surfels[v];
     if (dims.contains(s.inside()) && dims.contains(s.outside())) {
       voxels.push_back(s.inside());
       voxels.push_back(s.outside());
     }
+  }
   std::vector<double> f(voxels.size());
   source.values(voxels.data(), voxels.size(), f.data());
   std::size_t next = 0;
-  for (std::size_t v = 0; v < n; ++v) {
-    const Surfel& s = mesh.surfels[v];
+  for (std::size_t v = begin; v < end; ++v) {
+    const Surfel& s = surfels[v];
     double t = 0.5;  // a voxel outside the domain: no gray value to interpolate
     if (dims.contains(s.inside()) && dims.contains(s.outside())) {
       const double fc = f[next], fd = f[next + 1];
@@ -171,14 +175,28 @@ static std::vector<std::array<double, 3>> placeVertices(const VoxelSource& sourc
     }
     points[v] = pointOnSurfel(s, t);
   }
-  return points;
 }
 
 void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mapping,
-                  const Selection& selection, double epsilon, Surface& out) {
+                  const Selection& selection, double epsilon, Surface& out, int threads) {
   const ImageGeometry geometry = source.geometry();
-  out.vertices = placeVertices(source, mesh, mapping, selection, epsilon);
-  for (auto& p : out.vertices) p = geometry.toPhysical(p);
+  const std::size_t n = mesh.surfels.size();
+  out.vertices.resize(n);
+  // Runs of up to 2^15 vertices, each placed on its own (the source may be read from several
+  // threads at once); the same points for any number of threads.
+  const std::size_t kRun = std::clamp<std::size_t>(n / 64, 1024, std::size_t(1) << 15);
+  auto place = [&](std::size_t r) {
+    const std::size_t begin = r * kRun, end = std::min(n, begin + kRun);
+    placeVertices(source, mesh.surfels, mapping, selection, epsilon, begin, end, out.vertices.data());
+    for (std::size_t v = begin; v < end; ++v) out.vertices[v] = geometry.toPhysical(out.vertices[v]);
+  };
+  const std::size_t runs = (n + kRun - 1) / kRun;
+  if (threads == 1 || runs < 2 || (threads == 0 && n < (std::size_t(1) << 16))) {
+    for (std::size_t r = 0; r < runs; ++r) place(r);
+  } else {
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    arena.execute([&] { tbb::parallel_for(std::size_t(0), runs, place); });
+  }
   out.surfels = std::move(mesh.surfels);
   out.triangles = std::move(mesh.triangles);
   if (geometry.handedness() < 0)  // a mirrored frame: keep the normals pointing outwards
@@ -223,16 +241,15 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
     std::size_t expected = 0;
     switch (o.seed.kind) {
       case Kind::Largest: {
-        const TriangleMesh all = scanIsoSurface(binary, o.pair, o.threads);
-        std::size_t count = 0;
-        const std::vector<std::uint32_t> component = meshComponents(all, count);
-        if (count == 0) throwEmpty(source, o.selection);
-        std::vector<std::size_t> size(count, 0);
-        for (std::uint32_t c : component) ++size[c];
-        const std::size_t best = std::size_t(std::max_element(size.begin(), size.end()) - size.begin());
-        seed = all.surfels[std::size_t(std::find(component.begin(), component.end(), best) - component.begin())];
-        out.boundariesInImage = count;
-        expected = size[best];
+        // Every boundary's surfel count from a scan that builds no triangle; ties go to the
+        // boundary met first, as in the components of the scanned mesh.
+        const std::vector<BoundaryCount> boundaries = scanBoundaryCounts(binary, o.pair, o.threads);
+        if (boundaries.empty()) throwEmpty(source, o.selection);
+        const auto best = std::max_element(boundaries.begin(), boundaries.end(),
+                                           [](const BoundaryCount& a, const BoundaryCount& b) { return a.surfels < b.surfels; });
+        seed = best->seed;
+        out.boundariesInImage = boundaries.size();
+        expected = best->surfels;
         break;
       }
       case Kind::Ray: seed = resolveVoxelSeed(binary, o.seed.voxel, out.seed); break;
@@ -279,7 +296,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
 
     stages.begin("track");
     const SurfaceGraph graph =
-        trackComponent(binary, seed, o.pair, [&](std::size_t n) { stages.surfelsFound(n); });
+        trackComponent(binary, seed, o.pair, [&](std::size_t n) { stages.surfelsFound(n); }, o.threads);
     if (expected && graph.surfelCount() != expected) {
       std::ostringstream msg;
       msg << "tracking from " << seed << " found " << graph.surfelCount() << " surfels, the scan "
@@ -288,14 +305,14 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
     }
     stages.begin("convert");
     try {
-      mesh = extractLoops(graph);  // from the bricks the tracker read: the same image
+      mesh = extractLoops(graph, o.threads);  // from the bricks the tracker read: the same image
     } catch (const std::logic_error& e) {
       throw InternalError(e.what());
     }
   }
 
   stages.begin("place");
-  placeSurface(source, std::move(mesh), out.mapping, o.selection, o.epsilon, out);
+  placeSurface(source, std::move(mesh), out.mapping, o.selection, o.epsilon, out, o.threads);
   // A scan (all, largest) reads the whole domain; the rest is what the seed rule, the tracker and
   // the linear mapping asked for.
   out.voxelsRead = binary.voxelsRead() + (out.mapping == Mapping::Linear ? 2 * out.surfels.size() : 0) +

@@ -10,10 +10,11 @@ namespace surftrack {
 /// Moves `mesh` into `out`: vertices placed by the boundary mapping (paper §3.1; `epsilon` for
 /// the linear one, which reads the gray values from `source`) and then by the source's geometry,
 /// triangles oriented from the 1-voxels to the 0-voxels in physical space (a mirrored geometry
-/// swaps them).
+/// swaps them); on `threads` threads (0: all cores; the source is then read from several at
+/// once), the same vertices for any number.
 /// \pre mapping is Midpoint or Linear (not Default).
 void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mapping,
-                  const Selection& selection, double epsilon, Surface& out);
+                  const Selection& selection, double epsilon, Surface& out, int threads = 1);
 
 /// Sets out.components and out.euler from its vertices and triangles.
 void addFigures(Surface& out);

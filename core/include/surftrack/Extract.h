@@ -81,8 +81,9 @@ struct ExtractOptions {
   std::function<void(const ProgressEvent&)> progress;
   /// If set and raised, the extraction stops at the next check and throws Cancelled.
   const std::atomic<bool>* cancel = nullptr;
-  /// Threads for the scanning method (largest, all): 0 for all cores. The surface is the same
-  /// for any number. The source is then read from several threads at once.
+  /// Threads for the scanning method (largest, all), the second pass of tracking and the loop
+  /// extraction and the placement of the vertices: 0 for all cores. The surface is the same for
+  /// any number. The source is then read from several threads at once.
   int threads = 0;
   /// Per-component figures (a union-find over the vertices): off, `components` stays empty,
   /// `euler` 0 and, for `all`, `boundariesInImage` 0 — for callers that need only the mesh.
