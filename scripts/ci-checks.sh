@@ -22,9 +22,10 @@ if ! command -v clang++ >/dev/null; then
 fi
 
 start=$(date +%s)
-# -O1 with line tables: readable sanitizer stacks at a fraction of -O3's compile time.
+# Release (-O3): the instrumented tests run about 4x slower than the normal build's, against 8x at
+# -O1, for a similar compile time; stacks name functions (frame pointers kept), not lines.
 cmake -S . -B build-sanitize -DSURFTRACK_SANITIZE=ON -DSURFTRACK_BUILD_BENCH=OFF \
-      -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" >/dev/null
+      -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build-sanitize -j2 >build-sanitize.log 2>&1 || { tail -60 build-sanitize.log; exit 1; }
 built=$(date +%s)
 echo "ci-checks: sanitized build in $((built - start)) s"

@@ -16,6 +16,7 @@
 #include <set>
 #include <vector>
 
+#include "CaseSubset.h"
 #include "DigitalCube.h"
 #include "LoopExtraction.h"
 #include "Phantoms.h"
@@ -77,7 +78,8 @@ std::vector<BinaryVolume> randomImages(int count, std::uint64_t seed) {
   for (int i = 0; i < count; ++i) {
     const Dims d{3 + int(rng() % 14), 3 + int(rng() % 14), 3 + int(rng() % 14)};
     const double density = 0.1 + 0.8 * double(rng() >> 11) * 0x1p-53;
-    out.push_back(randomVolume(d, density, std::uint32_t(rng())));
+    const std::uint32_t seed = std::uint32_t(rng());
+    if (surftrack::testing::caseChecked(std::uint64_t(i))) out.push_back(randomVolume(d, density, seed));
   }
   return out;
 }
@@ -86,7 +88,8 @@ std::vector<BinaryVolume> randomImages(int count, std::uint64_t seed) {
 std::vector<BinaryVolume> allImages(Dims dims) {
   const int n = int(dims.count());
   std::vector<BinaryVolume> out;
-  for (int bits = 0; bits < (1 << n); ++bits) out.push_back(surftrack::testing::volumeFromBits(dims, bits));
+  for (int bits = 0; bits < (1 << n); ++bits)
+    if (surftrack::testing::caseChecked(std::uint64_t(bits))) out.push_back(surftrack::testing::volumeFromBits(dims, bits));
   return out;
 }
 
