@@ -336,7 +336,7 @@ TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
     }
 
     // Seeds: the voxel's boundary is that of SeedRule::ray(voxel) for its label.
-    options.boundaries = LabelBoundaries::FromSeeds;
+    options.boundaries = LabelBoundaries::All;  // with seeds: the seeds' boundaries
     std::mt19937 rng(seed);
     for (int i = 0; i < 3; ++i) {
       Voxel v{};
@@ -417,8 +417,10 @@ TEST(Labels, BadInputIsOneLineInvalidInput) {
   o.background = -1;
   expectMessage(o, view, "background -1 is not a value of uint16");
   o.background = 0;
-  o.boundaries = LabelBoundaries::FromSeeds;
-  expectMessage(o, view, "no seed voxel");
+  o.seeds = {Voxel{1, 0, 0}};
+  o.boundaries = LabelBoundaries::Largest;
+  expectMessage(o, view, "not both");
+  o.boundaries = LabelBoundaries::All;
   o.seeds = {Voxel{0, 0, 0}};
   expectMessage(o, view, "on the background");
   o.seeds = {Voxel{9, 0, 0}};
