@@ -203,6 +203,7 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   if (o.labels.kind == LabelSelection::Kind::Range) requireNonEmptyRange(o.labels);
   const WantedLabel<T> wanted(o.labels);
   LabelScan<T> scan = scanLabelSurfaces(image, T(o.background), wanted, o.pair, arena, parts);
+
   requireExactLabels(scan.labels);
   const std::vector<std::size_t> selected = selectLabels(scan.labels, o.labels, o.background);
   // Largest first, so that the last to finish are small.

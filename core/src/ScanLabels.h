@@ -21,6 +21,7 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <unordered_map>
@@ -52,6 +53,31 @@ namespace scanlabels {
 inline constexpr std::uint32_t kNone = ~std::uint32_t(0);  ///< background, unwanted, outside
 inline constexpr std::uint32_t kNextSlab = std::uint32_t(1) << 31;
 
+/// A configuration's triangles, each vertex as the L-corner c of its cube edge (bits 0-2) and
+/// the directions of that corner's surfels numbered before it (bits 3-8: those below the edge's
+/// direction), so that a vertex is first + popcount(directions & mask) of its corner.
+struct Config {
+  int triangles = 0;
+  std::array<std::array<std::uint16_t, 3>, CubeTriangulation::kMaxTriangles> corners{};
+};
+
+inline std::array<Config, 256> configTable(AdjacencyPair pair) {
+  std::array<Config, 256> out;
+  for (int config = 0; config < 256; ++config) {
+    const CubeTriangulation& t = configurationTable(pair, std::uint8_t(config));
+    out[config].triangles = t.triangleCount;
+    for (int i = 0; i < t.triangleCount; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const int edge = t.triangles[i][j];
+        const int low = cube::edgeLowCorner(edge), high = cube::edgeHighCorner(edge);
+        const bool lowIsL = config >> low & 1;
+        const int n = directionOf(cube::edgeAxis(edge), lowIsL ? +1 : -1);
+        out[config].corners[i][j] = std::uint16_t((lowIsL ? low : high) | ((1u << n) - 1) << 3);
+      }
+  }
+  return out;
+}
+
 /// One slab of planes [z0, z1): its labels (local indices), their surfels on its own planes and
 /// the triangles of its cubes (min corner z in [z0, z1), and -1 for the first slab).
 template <class T>
@@ -62,6 +88,23 @@ struct Slab {
   std::vector<std::vector<std::array<std::uint32_t, 3>>> triangles;
 };
 
+/// f(i) for every i in [0, n) with bytes[i] != 0, in order, eight zero bytes at a time skipped.
+template <class F>
+inline void forEachNonZero(const std::uint8_t* bytes, int n, F&& f) {
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, bytes + i, 8);
+    while (word) {
+      const int byte = std::countr_zero(word) >> 3;
+      f(i + byte);
+      word &= ~(std::uint64_t(0xFF) << (8 * byte));
+    }
+  }
+  for (; i < n; ++i)
+    if (bytes[i]) f(i);
+}
+
 /// The per-voxel planes of a slab: labels of the planes around the one being numbered (a ring
 /// of four), and for the two planes of the current cubes the first surfel number of each voxel
 /// and its surfel directions (bit n: a surfel of normal n).
@@ -69,7 +112,7 @@ template <class T, class Wanted>
 class SlabScanner {
  public:
   SlabScanner(const VolumeRef<T>& image, T background, const Wanted& wanted,
-              const std::array<const CubeTriangulation*, 256>& table)
+              const std::array<Config, 256>& table)
       : image_(image), background_(background), wanted_(wanted), table_(table),
         width_(image.dims.nx + 2), plane_(std::size_t(image.dims.nx + 2) * std::size_t(image.dims.ny + 2)) {
     for (auto& p : labelPlanes_) p.assign(plane_, kNone);
@@ -161,16 +204,20 @@ class SlabScanner {
     const std::size_t w = width_;
     for (int y = 0; y < dims.ny; ++y) {
       const std::size_t rowStart = std::size_t(y + 1) * w + 1;
+      // The directions of every voxel of the row first, without a branch (the compiler
+      // vectorises it); direction n = 2 axis + (sign < 0): +x, -x, +y, -y, +z, -z.
       for (int x = 0; x < dims.nx; ++x) {
         const std::size_t i = rowStart + std::size_t(x);
         const std::uint32_t L = here[i];
-        if (L == kNone) continue;
-        // Direction n = 2 axis + (sign < 0): +x, -x, +y, -y, +z, -z.
         const unsigned mask = unsigned(here[i + 1] != L) | unsigned(here[i - 1] != L) << 1 |
                               unsigned(here[i + w] != L) << 2 | unsigned(here[i - w] != L) << 3 |
                               unsigned(above[i] != L) << 4 | unsigned(below[i] != L) << 5;
-        dirs[i] = std::uint8_t(mask);
-        if (!mask) continue;
+        dirs[i] = std::uint8_t(L == kNone ? 0u : mask);
+      }
+      forEachNonZero(dirs + rowStart, dims.nx, [&](int x) {
+        const std::size_t i = rowStart + std::size_t(x);
+        const std::uint32_t L = here[i];
+        const unsigned mask = dirs[i];
         const std::uint32_t n = counters[L];
         first[i] = owned ? n : n | kNextSlab;
         counters[L] = n + std::uint32_t(std::popcount(mask));
@@ -180,7 +227,7 @@ class SlabScanner {
           for (unsigned m = mask; m; m &= m - 1)
             surfels.push_back(Surfel{Voxel{x, y, z}, Direction(std::countr_zero(m))});
         }
-      }
+      });
     }
   }
 
@@ -192,14 +239,20 @@ class SlabScanner {
     // Corner i of the cube at index p (x + 1, y + 1): plane bit 2, row bit 1, column bit 0.
     const std::size_t offset[8] = {0, 1, w, w + 1, 0, 1, w, w + 1};
     const Dims& dims = image_.dims;
+    mixed_.resize(width_ + 8);
     for (int y = -1; y < dims.ny; ++y) {
       const std::size_t rowStart = std::size_t(y + 1) * w;
-      for (int x = -1; x < dims.nx; ++x) {
-        const std::size_t p = rowStart + std::size_t(x + 1);
-        const std::uint32_t a = lo[p];
-        if (a == lo[p + 1] && a == lo[p + w] && a == lo[p + w + 1] && a == hi[p] && a == hi[p + 1] &&
-            a == hi[p + w] && a == hi[p + w + 1])
-          continue;  // one label (or none) on all 8 corners: no surfel
+      // Cube x + 1 of the row holds two labels (or a label and none) when its corner column x
+      // or x + 1 does, or the two columns differ; without a branch first (vectorised).
+      std::uint8_t* mixed = mixed_.data();
+      for (std::size_t i = 0; i < w; ++i) {
+        const std::uint32_t a = lo[rowStart + i];
+        mixed[i] = std::uint8_t((a != lo[rowStart + i + w]) | (a != hi[rowStart + i]) | (a != hi[rowStart + i + w]));
+      }
+      for (std::size_t i = 0; i + 1 < w; ++i)
+        mixed[i] = std::uint8_t(mixed[i] | mixed[i + 1] | (lo[rowStart + i] != lo[rowStart + i + 1]));
+      forEachNonZero(mixed, int(w) - 1, [&](int column) {
+        const std::size_t p = rowStart + std::size_t(column);
         std::uint32_t corner[8];
         for (int i = 0; i < 8; ++i) corner[i] = (i < 4 ? lo : hi)[p + offset[i]];
         unsigned done = 0;
@@ -209,33 +262,31 @@ class SlabScanner {
           unsigned config = 0;
           for (int j = i; j < 8; ++j) config |= unsigned(corner[j] == L) << j;
           done |= config;
-          auto vertex = [&](int edge) {
-            const int low = cube::edgeLowCorner(edge), high = cube::edgeHighCorner(edge), axis = cube::edgeAxis(edge);
-            const bool lowIsL = config >> low & 1;
-            const int c = lowIsL ? low : high;
-            const int n = directionOf(axis, lowIsL ? +1 : -1);
+          const Config& entry = table_[config];
+          auto vertex = [&](std::uint8_t corner) {
+            const int c = corner & 7, k = c >> 2;
             const std::size_t at = p + offset[c];
-            const int k = c >> 2;
-            return first_[k][at] + std::uint32_t(std::popcount(unsigned(directions_[k][at]) & ((1u << n) - 1)));
+            return first_[k][at] + std::uint32_t(std::popcount(unsigned(directions_[k][at] & (corner >> 3))));
           };
           auto& triangles = out_.triangles[L];
-          for (const auto& t : table_[config]->allTriangles())
-            triangles.push_back({vertex(t[0]), vertex(t[1]), vertex(t[2])});
+          for (int t = 0; t < entry.triangles; ++t)
+            triangles.push_back({vertex(entry.corners[t][0]), vertex(entry.corners[t][1]), vertex(entry.corners[t][2])});
         }
-      }
+      });
     }
   }
 
   const VolumeRef<T>& image_;
   T background_;
   const Wanted& wanted_;
-  const std::array<const CubeTriangulation*, 256>& table_;
+  const std::array<Config, 256>& table_;
   std::size_t width_, plane_;
   int z0_ = 0, z1_ = 0;
   std::array<std::vector<std::uint32_t>, 4> labelPlanes_;
   std::array<std::vector<std::uint32_t>, 2> first_;
   std::array<std::vector<std::uint8_t>, 2> directions_;
   std::vector<std::uint32_t> counters_, nextCounters_;
+  std::vector<std::uint8_t> mixed_;
   std::unordered_map<T, std::uint32_t> indexOf_;
   bool hasLast_ = false;
   T lastValue_{};
@@ -252,8 +303,7 @@ LabelScan<T> scanLabelSurfaces(const VolumeRef<T>& image, T background, const Wa
                                AdjacencyPair pair, tbb::task_arena& arena, int parts) {
   using namespace scanlabels;
   const Dims& dims = image.dims;
-  std::array<const CubeTriangulation*, 256> table{};
-  for (int config = 0; config < 256; ++config) table[config] = &configurationTable(pair, std::uint8_t(config));
+  const std::array<Config, 256> table = configTable(pair);
   parts = std::clamp(parts, 1, std::max(1, dims.nz));
   const auto slabCount = std::size_t(parts);
   std::vector<Slab<T>> slabs(slabCount);
@@ -292,6 +342,16 @@ LabelScan<T> scanLabelSurfaces(const VolumeRef<T>& image, T background, const Wa
       if (start.back() > std::numeric_limits<std::uint32_t>::max())
         throw std::length_error("a label has more than 2^32 - 1 surfels");
       TriangleMesh& mesh = out.meshes[g];
+      const auto holders = std::count_if(local.begin(), local.end(), [&](const auto& l) { return l[g] != kNone; });
+      if (holders == 1) {  // in one slab only: no number to shift, none in a next slab
+        for (std::size_t k = 0; k < slabs.size(); ++k)
+          if (const std::uint32_t i = local[k][g]; i != kNone) {
+            out.voxels[g] = slabs[k].voxels[i];
+            mesh.surfels = std::move(slabs[k].surfels[i]);
+            mesh.triangles = std::move(slabs[k].triangles[i]);
+          }
+        return;
+      }
       mesh.surfels.reserve(start.back());
       mesh.triangles.reserve(triangles);
       for (std::size_t k = 0; k < slabs.size(); ++k) {
@@ -304,11 +364,12 @@ LabelScan<T> scanLabelSurfaces(const VolumeRef<T>& image, T background, const Wa
         const auto own = std::uint32_t(start[k]);
         const auto next = std::uint32_t(start[std::min(k + 1, slabs.size())]);
         std::vector<std::array<std::uint32_t, 3>>& ts = slabs[k].triangles[i];
-        for (const auto& t : ts) {
-          std::array<std::uint32_t, 3> u;
-          for (int j = 0; j < 3; ++j) u[j] = t[j] & kNextSlab ? (t[j] & ~kNextSlab) + next : t[j] + own;
-          mesh.triangles.push_back(u);
-        }
+        const std::uint32_t add[2] = {own, next - kNextSlab};  // modulo 2^32
+        const std::size_t at = mesh.triangles.size();
+        mesh.triangles.resize(at + ts.size());
+        std::array<std::uint32_t, 3>* to = mesh.triangles.data() + at;
+        for (std::size_t t = 0; t < ts.size(); ++t)
+          for (int j = 0; j < 3; ++j) to[t][j] = ts[t][j] + add[ts[t][j] >> 31];
         std::vector<std::array<std::uint32_t, 3>>().swap(ts);
       }
     });
