@@ -88,9 +88,11 @@ struct LabelSurface {
 std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options);
 
 /// Writes every surface into one PLY file (binary little-endian, or text): the vertices of each
-/// label in turn (a vertex on an interface once per label it bounds), with an int property
-/// `label` on every vertex and every face. Through a temporary file renamed over `path`.
-/// \throw std::runtime_error naming the path when it cannot be written.
+/// label in turn (float x, y, z; a vertex on an interface once per label it bounds), the faces
+/// (int indices), with an int property `label` on every vertex and every face. Through a
+/// temporary file renamed over `path`.
+/// \throw InvalidInput for a label beyond int32 or more than 2^31 - 1 vertices;
+///        std::runtime_error naming the path when it cannot be written.
 void writeLabelSurfaces(const std::vector<LabelSurface>& surfaces, const std::string& path, bool binary = true);
 
 }  // namespace surftrack
