@@ -12,7 +12,10 @@
     cached in --cache): every label, all boundaries, on N threads, in a fresh
     process so that its peak resident memory (ru_maxrss) is that of loading the volume and
     extracting, compared with 2 x the volume + the output (the C++ surfaces: 24 bytes a vertex,
-    8 a surfel, 12 a triangle).
+    8 a surfel, 12 a triangle). Then, in another fresh process of the same run,
+    vtkDiscreteFlyingEdges3D on the same threads with the first --vtk-labels label values only
+    (it makes one pass over the volume per value: all 2,500 would take hours); its time for all
+    the labels is that time x cells / --vtk-labels, an extrapolation, printed as such.
 (c) --interfaces: on every atlas present, what two touching labels share: the fraction of
     each label's vertices that lie on another label's surface (interface surfels, shared by
     construction) and the fraction of its triangles whose three vertices are also a triangle of
@@ -166,6 +169,19 @@ def voronoi_worker(path: str, threads: int, repeat: int) -> None:
                       "volume_bytes": volume.nbytes, "rss_after_load": base, "peak_rss": peak}))
 
 
+def vtk_voronoi_worker(path: str, threads: int, repeat: int, count: int) -> None:
+    """In a fresh process: vtkDiscreteFlyingEdges3D with label values 1..count, `repeat` times."""
+    volume = np.load(path)
+    vtk = DiscreteFlyingEdges(threads)
+    times, points, polys = [], 0, 0
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        points, polys, keep = vtk(volume, list(range(1, count + 1)))
+        times.append(time.perf_counter() - t0)
+        del keep
+    print(json.dumps({"times": times, "points": points, "polys": polys, "description": vtk.description}))
+
+
 def part_voronoi(args) -> None:
     print(f"\n== (b) Voronoi {args.size}^3 uint32, {args.cells} cells, threads {args.threads}, "
           f"load {os.getloadavg()[0]:.2f}", flush=True)
@@ -187,6 +203,23 @@ def part_voronoi(args) -> None:
     print(f"peak RSS {r['peak_rss'] / mib:.0f} MiB (after loading the volume {r['rss_after_load'] / mib:.0f} MiB); "
           f"volume {r['volume_bytes'] / mib:.0f} MiB, output {output / mib:.0f} MiB, "
           f"limit 2 x volume + output = {limit / mib:.0f} MiB: {'met' if r['peak_rss'] <= limit else 'MISSED'}; "
+          f"load {os.getloadavg()[0]:.2f} after")
+    if args.vtk_labels <= 0:
+        return
+    count = min(args.vtk_labels, args.cells)
+    run = subprocess.run([sys.executable, os.path.abspath(__file__), "--vtk-voronoi-worker", args.cache,
+                          "--threads", str(args.threads), "--repeat", str(args.vtk_repeat),
+                          "--vtk-labels", str(count)],
+                         capture_output=True, text=True, check=True, env=os.environ)
+    v = json.loads(run.stdout.strip().splitlines()[-1])
+    assert v["points"] > 0 and v["polys"] > 0, v
+    tv = statistics.median(v["times"])
+    estimate = tv * args.cells / count
+    print(v["description"])
+    print(f"vtkDiscreteFlyingEdges3D, {count} of the {args.cells} labels: {tv:.3f} s  "
+          f"(runs {', '.join(f'{x:.3f}' for x in v['times'])}; {v['points']} points, {v['polys']} triangles)")
+    print(f"  all {args.cells} labels extrapolated: {estimate:.1f} s; ratio surftrack (all labels) / VTK "
+          f"(extrapolated) {t / estimate:.3f}; surftrack all labels / VTK {count} labels {t / tv:.2f}; "
           f"load {os.getloadavg()[0]:.2f} after")
 
 
@@ -236,10 +269,17 @@ def main(argv=None) -> int:
     parser.add_argument("--cells", type=int, default=2500, help="Voronoi cells (default 2500)")
     parser.add_argument("--cache", default="/tmp/surftrack-voronoi-512-2500.npy",
                         help="where the Voronoi volume is cached (default /tmp/surftrack-voronoi-512-2500.npy)")
+    parser.add_argument("--vtk-labels", type=int, default=50,
+                        help="(b): VTK on this many of the Voronoi labels, 0 for none (default 50)")
+    parser.add_argument("--vtk-repeat", type=int, default=3, help="(b): VTK runs; median (default 3)")
     parser.add_argument("--voronoi-worker", metavar="NPY", help=argparse.SUPPRESS)
+    parser.add_argument("--vtk-voronoi-worker", metavar="NPY", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.voronoi_worker:
         voronoi_worker(args.voronoi_worker, args.threads, args.repeat)
+        return 0
+    if args.vtk_voronoi_worker:
+        vtk_voronoi_worker(args.vtk_voronoi_worker, args.threads, args.repeat, args.vtk_labels)
         return 0
     import surftrack
     print(f"python {sys.version.split()[0]}, numpy {np.__version__}, surftrack from "

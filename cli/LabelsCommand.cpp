@@ -107,9 +107,7 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   else if (!o.labels.empty())
     options.labels = LabelSelection::list(std::vector<double>(o.labels.begin(), o.labels.end()));
   options.background = double(o.background);
-  options.boundaries = o.largest         ? LabelBoundaries::Largest
-                       : o.seeds.empty() ? LabelBoundaries::All
-                                         : LabelBoundaries::FromSeeds;
+  options.boundaries = o.largest ? LabelBoundaries::Largest : LabelBoundaries::All;
   options.seeds = o.seeds;
   options.pair = o.pair;
   options.threads = o.threads;

@@ -117,10 +117,32 @@ void StagedOutputs::commit() {
     fs::rename(staging_, directory_, ec);  // replaces an empty directory
     if (ec) throw std::runtime_error("cannot move the outputs into '" + directory_ + "': " + ec.message());
   } else {
+    // All or nothing, as far as renames allow: the files already there are moved aside first;
+    // if a rename fails, the new files moved so far are removed and the old ones put back.
+    std::vector<std::pair<std::string, std::string>> aside;  // (target, its old file's name)
+    std::size_t moved = 0;
+    auto undo = [&](const std::string& target, const std::error_code& error) {
+      std::error_code ignored;
+      for (std::size_t i = 0; i < moved; ++i) fs::remove(files_[i].second, ignored);
+      for (const auto& [old, backup] : aside) fs::rename(backup, old, ignored);
+      return std::runtime_error("cannot write '" + target + "': " + error.message() +
+                                " (no output written)");
+    };
     for (const auto& [temporary, target] : files_) {
-      fs::rename(temporary, target, ec);
-      if (ec) throw std::runtime_error("cannot write '" + target + "': " + ec.message());
+      if (!fs::is_regular_file(target, ec)) continue;
+      const fs::path t(target);
+      const std::string backup =
+          (t.parent_path() / hiddenTemporaryName(t.stem().string(), t.extension().string())).string();
+      fs::rename(target, backup, ec);
+      if (ec) throw undo(target, ec);
+      aside.emplace_back(target, backup);
     }
+    for (; moved < files_.size(); ++moved) {
+      fs::rename(files_[moved].first, files_[moved].second, ec);
+      if (ec) throw undo(files_[moved].second, ec);
+    }
+    std::error_code ignored;
+    for (const auto& [old, backup] : aside) fs::remove(backup, ignored);
   }
   committed_ = true;
 }

@@ -25,8 +25,10 @@ std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bo
 /// Several output files written completely or not at all: each is written under a temporary
 /// name, and commit() moves them all into place. In a directory of outputs the temporary names
 /// lie in a staging directory next to it, which commit() renames to the directory (which must
-/// then not exist, or be empty); otherwise they lie next to their targets. Whatever commit()
-/// has not moved is removed by the destructor (an error, an exception on the way).
+/// then not exist, or be empty); otherwise they lie next to their targets, and commit() moves
+/// the files already there aside, renames the new ones over them and, if a rename fails,
+/// removes the new ones it moved and puts the old ones back. Whatever commit() has not moved is
+/// removed by the destructor (an error, an exception on the way).
 class StagedOutputs {
  public:
   /// Outputs inside `directory`. Throws std::runtime_error (one line) if it is a non-empty

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <system_error>
@@ -125,41 +126,82 @@ class TriangleListExporter final : public OpenMesh::IO::BaseExporter {
 /// Binary PLY, the most common output, byte for byte as OpenMesh's PLY writer writes it for a
 /// SurfaceMesh (the tests compare both), but from whole arrays: OpenMesh's writer goes value by
 /// value through the exporter and the stream, about 50 MB/s on this project's machines
-/// (docs/performance.md), a large part of a seeded extraction. False if a write fails.
-bool writeBinaryPly(const std::vector<std::array<double, 3>>& vertices,
-                    const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path) {
+/// (docs/performance.md), a large part of a seeded extraction. Several meshes go one after the
+/// other (their triangles' indices shifted); `labelled` adds an int property `label` to every
+/// vertex and face (writeLabelledTriangles). Binary, or text for writeLabelledTriangles. False if
+/// a write fails.
+bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binary, const std::string& path) {
   static_assert(std::endian::native == std::endian::little, "binary_little_endian is written as is");
+  std::size_t vertexCount = 0, faceCount = 0;
+  for (const LabelledMesh& m : meshes) vertexCount += m.vertices->size(), faceCount += m.triangles->size();
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) return false;
-  const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " +
-                             std::to_string(vertices.size()) +
-                             "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-                             std::to_string(triangles.size()) +
-                             "\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string label = labelled ? "property int label\n" : "";
+  const std::string header = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
+                             " 1.0\n" + (labelled ? "comment surftrack label surfaces: one closed surface per label\n" : "") +
+                             "element vertex " + std::to_string(vertexCount) +
+                             "\nproperty float x\nproperty float y\nproperty float z\n" + label + "element face " +
+                             std::to_string(faceCount) + "\nproperty list uchar int vertex_indices\n" + label +
+                             "end_header\n";
   bool ok = std::fwrite(header.data(), 1, header.size(), file) == header.size();
+  const std::size_t extra = labelled ? 4 : 0;
   constexpr std::size_t kChunk = 1 << 16;  // items per buffer
-  std::vector<unsigned char> buffer(kChunk * 13);
-  for (std::size_t begin = 0; ok && begin < vertices.size(); begin += kChunk) {
-    const std::size_t n = std::min(kChunk, vertices.size() - begin);
-    unsigned char* out = buffer.data();
-    for (std::size_t v = begin; v < begin + n; ++v, out += 12) {
-      const float p[3] = {float(vertices[v][0]), float(vertices[v][1]), float(vertices[v][2])};
-      std::memcpy(out, p, 12);
+  std::vector<unsigned char> buffer(kChunk * (13 + extra));
+  std::string text;
+  for (const LabelledMesh& m : meshes) {
+    const auto& vertices = *m.vertices;
+    for (std::size_t begin = 0; ok && begin < vertices.size(); begin += kChunk) {
+      const std::size_t n = std::min(kChunk, vertices.size() - begin);
+      unsigned char* out = buffer.data();
+      text.clear();
+      for (std::size_t v = begin; v < begin + n; ++v, out += 12 + extra) {
+        const float p[3] = {float(vertices[v][0]), float(vertices[v][1]), float(vertices[v][2])};
+        if (!binary) {
+          char line[96];
+          const int length = labelled ? std::snprintf(line, sizeof line, "%.9g %.9g %.9g %d\n", p[0], p[1], p[2], m.label)
+                                      : std::snprintf(line, sizeof line, "%.9g %.9g %.9g\n", p[0], p[1], p[2]);
+          text.append(line, std::size_t(length));
+          continue;
+        }
+        std::memcpy(out, p, 12);
+        if (labelled) std::memcpy(out + 12, &m.label, 4);
+      }
+      ok = binary ? std::fwrite(buffer.data(), 12 + extra, n, file) == n
+                  : std::fwrite(text.data(), 1, text.size(), file) == text.size();
     }
-    ok = std::fwrite(buffer.data(), 12, n, file) == n;
   }
-  for (std::size_t begin = 0; ok && begin < triangles.size(); begin += kChunk) {
-    const std::size_t n = std::min(kChunk, triangles.size() - begin);
-    unsigned char* out = buffer.data();
-    for (std::size_t f = begin; f < begin + n; ++f, out += 13) {
-      out[0] = 3;
-      const std::int32_t t[3] = {std::int32_t(triangles[f][0]), std::int32_t(triangles[f][1]),
-                                 std::int32_t(triangles[f][2])};
-      std::memcpy(out + 1, t, 12);
+  std::size_t offset = 0;
+  for (const LabelledMesh& m : meshes) {
+    const auto& triangles = *m.triangles;
+    for (std::size_t begin = 0; ok && begin < triangles.size(); begin += kChunk) {
+      const std::size_t n = std::min(kChunk, triangles.size() - begin);
+      unsigned char* out = buffer.data();
+      text.clear();
+      for (std::size_t f = begin; f < begin + n; ++f, out += 13 + extra) {
+        const std::int32_t t[3] = {std::int32_t(triangles[f][0] + offset), std::int32_t(triangles[f][1] + offset),
+                                   std::int32_t(triangles[f][2] + offset)};
+        if (!binary) {
+          char line[64];
+          const int length = labelled ? std::snprintf(line, sizeof line, "3 %d %d %d %d\n", t[0], t[1], t[2], m.label)
+                                      : std::snprintf(line, sizeof line, "3 %d %d %d\n", t[0], t[1], t[2]);
+          text.append(line, std::size_t(length));
+          continue;
+        }
+        out[0] = 3;
+        std::memcpy(out + 1, t, 12);
+        if (labelled) std::memcpy(out + 13, &m.label, 4);
+      }
+      ok = binary ? std::fwrite(buffer.data(), 13 + extra, n, file) == n
+                  : std::fwrite(text.data(), 1, text.size(), file) == text.size();
     }
-    ok = std::fwrite(buffer.data(), 13, n, file) == n;
+    offset += m.vertices->size();
   }
   return std::fclose(file) == 0 && ok;
+}
+
+bool writeBinaryPly(const std::vector<std::array<double, 3>>& vertices,
+                    const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path) {
+  return writePly({LabelledMesh{&vertices, &triangles, 0}}, false, true, path);
 }
 
 /// The extension of `path` if it is one writeMesh knows, else std::invalid_argument.
@@ -208,6 +250,16 @@ void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
     return ext == ".ply" && binary ? writeBinaryPly(vertices, triangles, temporary)
                                    : OpenMesh::IO::IOManager().write(temporary, exporter, options, 12);
   });
+}
+
+void writeLabelledTriangles(const std::vector<LabelledMesh>& meshes, const std::string& path, bool binary) {
+  if (meshExtension(path) != ".ply")
+    throw std::invalid_argument("cannot write '" + path + "': labelled meshes are written as .ply");
+  std::size_t vertices = 0;
+  for (const LabelledMesh& m : meshes) vertices += m.vertices->size();
+  if (vertices > std::size_t(std::numeric_limits<std::int32_t>::max()))
+    throw std::invalid_argument("cannot write '" + path + "': more than 2^31 - 1 vertices in one PLY");
+  writeFileAtomically(path, [&](const std::string& temporary) { return writePly(meshes, true, binary, temporary); });
 }
 
 void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary) {

@@ -27,6 +27,20 @@ void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary = t
 void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
                     const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path,
                     bool binary = true);
+/// One mesh of a labelled PLY file (writeLabelledTriangles); the arrays are not copied.
+struct LabelledMesh {
+  const std::vector<std::array<double, 3>>* vertices;
+  const std::vector<std::array<std::uint32_t, 3>>* triangles;
+  std::int32_t label;
+};
+
+/// Writes the meshes into one .ply (binary little-endian, or text), the vertices of each mesh in
+/// turn and its triangles' indices shifted to them, with an int property `label` on every vertex
+/// and every face: writeTriangles' binary PLY writer with one more column. Through
+/// writeFileAtomically. \throw std::invalid_argument for another extension or more than
+/// 2^31 - 1 vertices, std::runtime_error naming the path when it cannot be written.
+void writeLabelledTriangles(const std::vector<LabelledMesh>& meshes, const std::string& path, bool binary = true);
+
 /// Calls write(temporary) with a fresh file name next to `path` (same directory and extension),
 /// then renames that file over `path`: a reader sees the old file or the whole new one, never a
 /// partial one. If `write` throws or returns false the temporary file is removed and

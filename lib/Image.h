@@ -91,6 +91,24 @@ struct VolumeRef {
   }
 };
 
+namespace detail {
+
+inline std::uint64_t lowBits(int n) { return n >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1; }
+
+/// The row(x0, y, z, count) of a binary image on the domain `d` (ThresholdImage, LabelImage):
+/// bits i of the count <= 64 voxels (x0 + i, y, z), `outside` for those outside the domain and
+/// inDomain(lo, hi) (the bits i in [lo, hi), in place) for the others, lo < hi.
+template <class InDomain>
+std::uint64_t rowBits(const Dims& d, int x0, int y, int z, int count, bool outside, InDomain&& inDomain) {
+  const std::uint64_t all = lowBits(count);
+  if (y < 0 || z < 0 || y >= d.ny || z >= d.nz || x0 >= d.nx || x0 + count <= 0) return outside ? all : 0;
+  const int lo = x0 < 0 ? -x0 : 0, hi = x0 + count > d.nx ? d.nx - x0 : count;
+  const std::uint64_t bits = outside ? all & ~(lowBits(hi - lo) << lo) : 0;
+  return bits | inDomain(lo, hi);
+}
+
+}  // namespace detail
+
 /// Binary image of a gray image J at iso-value s (§3.1): f(v) > s is a 1-voxel.
 template <class T>
 class ThresholdImage {
@@ -143,24 +161,20 @@ class ThresholdImage {
   /// Values of the `count` <= 64 voxels (x0 + i, y, z) as bits i: the fast path of the
   /// scanner and of the tracker's brick cache, which binarise whole rows.
   std::uint64_t row(int x0, int y, int z, int count) const {
-    const Dims& d = image_.dims;
-    const std::uint64_t all = lowBits(count);
-    if (y < 0 || z < 0 || y >= d.ny || z >= d.nz || x0 >= d.nx || x0 + count <= 0)
-      return outside_ ? all : 0;
-    const int lo = x0 < 0 ? -x0 : 0, hi = x0 + count > d.nx ? d.nx - x0 : count;
-    const std::uint64_t bits = outside_ ? all & ~(lowBits(hi - lo) << lo) : 0;
-    if (image_.sx != 1) [[unlikely]] {
-      std::uint64_t strided = 0;
-      for (int i = lo; i < hi; ++i) strided |= std::uint64_t(double(image_.at(x0 + i, y, z)) > iso_) << i;
-      return bits | strided;
-    }
-    return bits | (compare(&image_.at(x0 + lo, y, z), hi - lo) << lo);
+    return detail::rowBits(image_.dims, x0, y, z, count, outside_, [&](int lo, int hi) {
+      if (image_.sx != 1) [[unlikely]] {
+        std::uint64_t strided = 0;
+        for (int i = lo; i < hi; ++i) strided |= std::uint64_t(double(image_.at(x0 + i, y, z)) > iso_) << i;
+        return strided;
+      }
+      return compare(&image_.at(x0 + lo, y, z), hi - lo) << lo;
+    });
   }
 
  private:
   enum class Mode { Compare, AllOnes, AllZeros };
 
-  static std::uint64_t lowBits(int n) { return n >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1; }
+  static std::uint64_t lowBits(int n) { return detail::lowBits(n); }
 
 #if defined(__SSE2__)
   /// Bit i is values[i] > s for the 16 uint8 values from `values` (mode Compare): unsigned
@@ -214,18 +228,13 @@ class LabelImage {
   /// Values of the `count` <= 64 voxels (x0 + i, y, z) as bits i (ThresholdImage::row's
   /// contract): the scanner and the front door read label images a row at a time.
   std::uint64_t row(int x0, int y, int z, int count) const {
-    auto low = [](int n) { return n <= 0 ? 0 : n >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1; };
-    const bool inRow = y >= 0 && z >= 0 && y < image_.dims.ny && z < image_.dims.nz;
-    // Bits [lo, hi) lie in the domain; the others take the outside value.
-    const int lo = inRow ? std::clamp(-x0, 0, count) : count;
-    const int hi = inRow ? std::clamp(image_.dims.nx - x0, lo, count) : count;
-    std::uint64_t bits = outside_ ? low(count) & ~(low(hi) & ~low(lo)) : 0;
-    if (lo < hi) {
+    return detail::rowBits(image_.dims, x0, y, z, count, outside_, [&](int lo, int hi) {
+      std::uint64_t bits = 0;
       const T* p = &image_.at(x0 + lo, y, z);
       const std::ptrdiff_t sx = image_.sx;
       for (int i = lo; i < hi; ++i, p += sx) bits |= std::uint64_t(*p == label_) << i;
-    }
-    return bits;
+      return bits;
+    });
   }
 
  private:

@@ -876,6 +876,28 @@ TEST_F(Cli, LabelsWritesOnePlyWithALabelPerFaceAndPatterns) {
   EXPECT_FALSE(fs::exists(path("mesh-9.obj")));
 }
 
+TEST_F(Cli, LabelsPatternFailingMidwayLeavesNoFile) {
+  const DenseImage<std::uint16_t> image = labelBalls();
+  const std::string in = path("labels.nrrd");
+  io::writeVolume(io::AnyVolume(image), in);
+  fs::create_directories(path("pattern"));
+  std::ofstream(path("pattern/mesh-1.ply")) << "old";  // an old output, to be kept as it is
+  // Label 7's target is a directory: the labels before it are written, then the run fails.
+  fs::create_directories(path("pattern/mesh-7.ply"));
+  expectFailure({"labels", in, "-o", path("pattern/mesh-{label}.ply")}, 1, "is a directory");
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(path("pattern"))) left.push_back(e.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"mesh-1.ply", "mesh-7.ply"})) << "no new file, no temporary";
+  EXPECT_EQ(readText(path("pattern/mesh-1.ply")), "old");
+  // Without the obstacle the same run replaces the old output and writes every label.
+  fs::remove(path("pattern/mesh-7.ply"));
+  const RunResult r = run({"labels", in, "-o", path("pattern/mesh-{label}.ply"), "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(readText(path("pattern/mesh-1.ply")), "old");
+  EXPECT_TRUE(fs::exists(path("pattern/mesh-7.ply")));
+}
+
 TEST_F(Cli, LabelsBadInputIsOneLineAndLeavesNothing) {
   const DenseImage<std::uint16_t> image = labelBalls();
   const std::string in = path("labels.nrrd"), floats = path("floats.nrrd");

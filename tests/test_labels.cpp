@@ -7,10 +7,14 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <random>
 #include <set>
 #include <unordered_map>
+
+#include <unistd.h>
 
 #include "Extract.h"
 #include "Labels.h"
@@ -297,6 +301,132 @@ TEST(Labels, FiveHundredRandomLabelImages) {
   }
 }
 
+/// A labelled PLY as read back by a reader of its own (not the writer's code): the header's
+/// element counts and properties, then float x y z + int label per vertex, uchar 3 + int
+/// indices + int label per face, binary little-endian or text.
+struct LabelledPly {
+  std::vector<std::array<float, 3>> points;
+  std::vector<std::int32_t> vertexLabels, faceLabels;
+  std::vector<std::array<std::int32_t, 3>> faces;
+};
+
+LabelledPly readLabelledPly(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line, format;
+  std::vector<std::string> header;
+  std::size_t vertices = 0, faces = 0;
+  while (std::getline(in, line) && line != "end_header") {
+    header.push_back(line);
+    std::istringstream words(line);
+    std::string word, kind;
+    words >> word;
+    if (word == "format") words >> format;
+    if (word == "element") {
+      words >> kind;
+      (kind == "vertex" ? vertices : faces) = std::stoul(line.substr(line.rfind(' ') + 1));
+    }
+  }
+  const std::vector<std::string> properties = {"property float x", "property float y", "property float z",
+                                               "property int label", "property list uchar int vertex_indices",
+                                               "property int label"};
+  std::vector<std::string> found;
+  for (const std::string& h : header)
+    if (h.rfind("property", 0) == 0) found.push_back(h);
+  EXPECT_EQ(found, properties);
+  LabelledPly ply;
+  ply.points.resize(vertices);
+  ply.vertexLabels.resize(vertices);
+  ply.faces.resize(faces);
+  ply.faceLabels.resize(faces);
+  const bool binary = format == "binary_little_endian";
+  EXPECT_TRUE(binary || format == "ascii") << format;
+  for (std::size_t v = 0; v < vertices; ++v) {
+    if (binary) {
+      in.read(reinterpret_cast<char*>(ply.points[v].data()), 12);
+      in.read(reinterpret_cast<char*>(&ply.vertexLabels[v]), 4);
+    } else {
+      in >> ply.points[v][0] >> ply.points[v][1] >> ply.points[v][2] >> ply.vertexLabels[v];
+    }
+  }
+  for (std::size_t f = 0; f < faces; ++f) {
+    int count = 0;
+    if (binary) {
+      unsigned char n = 0;
+      in.read(reinterpret_cast<char*>(&n), 1);
+      count = n;
+      in.read(reinterpret_cast<char*>(ply.faces[f].data()), 12);
+      in.read(reinterpret_cast<char*>(&ply.faceLabels[f]), 4);
+    } else {
+      in >> count >> ply.faces[f][0] >> ply.faces[f][1] >> ply.faces[f][2] >> ply.faceLabels[f];
+    }
+    EXPECT_EQ(count, 3);
+  }
+  EXPECT_TRUE(bool(in)) << path << ": shorter than its header says";
+  if (binary) {
+    EXPECT_EQ(in.peek(), std::char_traits<char>::eof()) << path << ": longer than its header says";
+  }
+  return ply;
+}
+
+TEST(Labels, OnePlyOfEveryLabelReadsBackWithItsLabelsClosed) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("surftrack-test-labels-ply-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (std::uint32_t seed = 0; seed < 40; ++seed) {
+    std::int64_t background = 0;
+    std::string shape;
+    const LabelVolume volume = randomLabels(seed, background, shape);
+    const std::vector<std::int32_t> data = typed<std::int32_t>(volume);
+    LabelOptions options;
+    options.background = double(background);
+    options.pair = kPairs[seed % 4];
+    std::vector<LabelSurface> surfaces;
+    try {
+      surfaces = extractLabels(VolumeView::of(data.data(), volume.dims), options);
+    } catch (const InvalidInput&) {
+      continue;  // background alone
+    }
+    for (const bool binary : {true, false}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + (binary ? " binary" : " text"));
+      const std::string path = (dir / "all.ply").string();
+      writeLabelSurfaces(surfaces, path, binary);
+      const LabelledPly ply = readLabelledPly(path);
+      std::size_t vertex = 0, face = 0;
+      for (const LabelSurface& ls : surfaces) {
+        const Surface& s = ls.surface;
+        ASSERT_LE(vertex + s.vertices.size(), ply.points.size());
+        ASSERT_LE(face + s.triangles.size(), ply.faces.size());
+        for (std::size_t v = 0; v < s.vertices.size(); ++v) {
+          ASSERT_EQ(ply.vertexLabels[vertex + v], std::int32_t(ls.label));
+          for (int a = 0; a < 3; ++a) ASSERT_EQ(ply.points[vertex + v][a], float(s.vertices[v][a]));
+        }
+        // The label's faces: its label, indices among its own vertices, and every directed edge
+        // once with its reverse once (closed and oriented).
+        std::map<std::pair<std::int32_t, std::int32_t>, int> edges;
+        for (std::size_t f = 0; f < s.triangles.size(); ++f) {
+          ASSERT_EQ(ply.faceLabels[face + f], std::int32_t(ls.label));
+          const auto& t = ply.faces[face + f];
+          for (int j = 0; j < 3; ++j) {
+            ASSERT_GE(t[j], std::int32_t(vertex));
+            ASSERT_LT(t[j], std::int32_t(vertex + s.vertices.size()));
+            ASSERT_EQ(std::uint32_t(t[j] - std::int32_t(vertex)), s.triangles[f][j]);
+            ++edges[{t[j], t[(j + 1) % 3]}];
+          }
+        }
+        for (const auto& [e, count] : edges) {
+          ASSERT_EQ(count, 1) << "edge used twice in one direction";
+          ASSERT_EQ(edges.count({e.second, e.first}), 1u) << "a border edge";
+        }
+        vertex += s.vertices.size();
+        face += s.triangles.size();
+      }
+      EXPECT_EQ(vertex, ply.points.size());
+      EXPECT_EQ(face, ply.faces.size());
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
   for (std::uint32_t seed = 1000; seed < 1040; ++seed) {
     std::int64_t background = 0;
@@ -336,7 +466,7 @@ TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
     }
 
     // Seeds: the voxel's boundary is that of SeedRule::ray(voxel) for its label.
-    options.boundaries = LabelBoundaries::FromSeeds;
+    options.boundaries = LabelBoundaries::All;  // with seeds: the seeds' boundaries
     std::mt19937 rng(seed);
     for (int i = 0; i < 3; ++i) {
       Voxel v{};
@@ -417,8 +547,10 @@ TEST(Labels, BadInputIsOneLineInvalidInput) {
   o.background = -1;
   expectMessage(o, view, "background -1 is not a value of uint16");
   o.background = 0;
-  o.boundaries = LabelBoundaries::FromSeeds;
-  expectMessage(o, view, "no seed voxel");
+  o.seeds = {Voxel{1, 0, 0}};
+  o.boundaries = LabelBoundaries::Largest;
+  expectMessage(o, view, "not both");
+  o.boundaries = LabelBoundaries::All;
   o.seeds = {Voxel{0, 0, 0}};
   expectMessage(o, view, "on the background");
   o.seeds = {Voxel{9, 0, 0}};

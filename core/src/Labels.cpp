@@ -15,10 +15,13 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "FindSeed.h"
 #include "Image.h"
 #include "LabelSeeds.h"
 #include "LoopExtraction.h"
+#include "MeshComponents.h"
 #include "PlaceSurface.h"
+#include "ScanLabels.h"
 #include "SelectionValue.h"
 #include "SourceImage.h"
 #include "TrackBoundaries.h"
@@ -42,11 +45,48 @@ void forEachIndex(tbb::task_arena& arena, std::size_t n, F&& f) {
   });
 }
 
-/// The indices in `seeds.labels` of the labels `selection` asks for, in increasing order.
+/// A list selection's labels are values of the type other than the background.
 template <class T>
-std::vector<std::size_t> selectLabels(const LabelSeeds<T>& seeds, const LabelSelection& selection,
+void requireListable(const LabelSelection& selection, double background) {
+  if (selection.labels.empty()) throw InvalidInput("empty selection: the list of labels is empty");
+  for (double L : selection.labels) {
+    requireSelectable(scalarTypeOf<T>(), Selection::label(L));
+    if (L == background) throw InvalidInput("label " + numberText(L) + " is the background");
+  }
+}
+
+void requireNonEmptyRange(const LabelSelection& selection) {
+  if (std::isnan(selection.first) || std::isnan(selection.last) || selection.first > selection.last)
+    throw InvalidInput("label range [" + numberText(selection.first) + ", " + numberText(selection.last) +
+                       "] is empty");
+}
+
+/// Whether the scan converts label L (the selection checked by requireListable /
+/// requireNonEmptyRange; selectLabels then reports the listed labels that do not occur).
+template <class T>
+struct WantedLabel {
+  const LabelSelection& selection;
+  std::vector<T> listed;  ///< List: sorted
+  explicit WantedLabel(const LabelSelection& s) : selection(s) {
+    if (s.kind == LabelSelection::Kind::List) {
+      for (double L : s.labels) listed.push_back(T(L));
+      std::sort(listed.begin(), listed.end());
+    }
+  }
+  bool operator()(T L) const {
+    switch (selection.kind) {
+      case LabelSelection::Kind::List: return std::binary_search(listed.begin(), listed.end(), L);
+      case LabelSelection::Kind::Range: return double(L) >= selection.first && double(L) <= selection.last;
+      default: return true;
+    }
+  }
+};
+
+/// The indices in `labels` (increasing: those that occur) of the labels `selection` asks for,
+/// in increasing order.
+template <class T>
+std::vector<std::size_t> selectLabels(const std::vector<T>& labels, const LabelSelection& selection,
                                       double background) {
-  const std::vector<T>& labels = seeds.labels;
   std::vector<std::size_t> out;
   switch (selection.kind) {
     case LabelSelection::Kind::All:
@@ -56,10 +96,8 @@ std::vector<std::size_t> selectLabels(const LabelSeeds<T>& seeds, const LabelSel
         throw InvalidInput("empty selection: every voxel has the background label " + numberText(background));
       break;
     case LabelSelection::Kind::List:
-      if (selection.labels.empty()) throw InvalidInput("empty selection: the list of labels is empty");
+      requireListable<T>(selection, background);
       for (double L : selection.labels) {
-        requireSelectable(scalarTypeOf<T>(), Selection::label(L));
-        if (L == background) throw InvalidInput("label " + numberText(L) + " is the background");
         const auto at = std::lower_bound(labels.begin(), labels.end(), T(L));
         if (at == labels.end() || *at != T(L))
           throw InvalidInput("label " + numberText(L) + " does not occur in the image");
@@ -69,9 +107,7 @@ std::vector<std::size_t> selectLabels(const LabelSeeds<T>& seeds, const LabelSel
       out.erase(std::unique(out.begin(), out.end()), out.end());
       break;
     case LabelSelection::Kind::Range:
-      if (std::isnan(selection.first) || std::isnan(selection.last) || selection.first > selection.last)
-        throw InvalidInput("label range [" + numberText(selection.first) + ", " + numberText(selection.last) +
-                           "] is empty");
+      requireNonEmptyRange(selection);
       for (std::size_t i = 0; i < labels.size(); ++i)
         if (double(labels[i]) >= selection.first && double(labels[i]) <= selection.last) out.push_back(i);
       if (out.empty())
@@ -89,14 +125,13 @@ std::vector<std::vector<std::size_t>> wantedSeeds(const VolumeRef<T>& image, con
                                                   const std::vector<std::size_t>& selected,
                                                   const LabelOptions& o) {
   std::vector<std::vector<std::size_t>> wanted(seeds.labels.size());
-  if (o.boundaries != LabelBoundaries::FromSeeds) {
+  if (o.seeds.empty()) {
     for (std::size_t i : selected) {
       wanted[i].resize(seeds.surfels[i].size());
       std::iota(wanted[i].begin(), wanted[i].end(), std::size_t(0));
     }
     return wanted;
   }
-  if (o.seeds.empty()) throw InvalidInput("boundaries from seeds, but no seed voxel is given");
   const Dims& dims = image.dims;
   for (const Voxel& v : o.seeds) {
     if (!dims.contains(v)) {
@@ -112,10 +147,11 @@ std::vector<std::vector<std::size_t>> wantedSeeds(const VolumeRef<T>& image, con
     if (!std::binary_search(selected.begin(), selected.end(), i))
       throw InvalidInput("seed voxel " + voxelText(v) + " has label " + numberText(double(L)) +
                          ", which is not selected");
-    // The +x ray from the seed: its last voxel of L and the surfel towards +x.
-    int x = v.x;
-    while (x + 1 < dims.nx && image.at(x + 1, v.y, v.z) == L) ++x;
-    const std::uint64_t key = Surfel{Voxel{x, v.y, v.z}, 0}.key();
+    // The +x ray from the seed: its first 1 -> 0 step, the surfel (c, c + x) of the last voxel c
+    // of L on it (the ray leaves the domain, so there is one).
+    const std::optional<Surfel> ray = seedAlongRay(LabelImage<T>(image, L), v, directionOf(0, +1));
+    if (!ray) throw InternalError("no boundary on the +x ray of seed voxel " + voxelText(v));
+    const std::uint64_t key = ray->key();
     const auto& keys = seeds.surfels[i];
     const auto at = std::lower_bound(keys.begin(), keys.end(), key);
     if (at == keys.end() || *at != key) throw InternalError("the scan missed the seed surfel of seed voxel " + voxelText(v));
@@ -134,6 +170,61 @@ void append(TriangleMesh& to, TriangleMesh&& from) {
   for (auto t : from.triangles) to.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
 }
 
+/// Labels are exact as doubles (the front door's selections and results are doubles).
+template <class T>
+void requireExactLabels(const std::vector<T>& labels) {
+  if constexpr (sizeof(T) == 8)
+    for (T L : labels)
+      if (!(std::abs(double(L)) <= std::ldexp(1.0, 53)))
+        throw InvalidInput("label " + std::to_string(L) + " is beyond 2^53: labels must be exact as doubles");
+}
+
+/// The fields of a label's result that do not depend on how its mesh was made.
+LabelSurface labelSurface(const VoxelSource& source, double label, std::uint64_t voxels, TriangleMesh&& mesh,
+                          const LabelOptions& o) {
+  LabelSurface result;
+  result.label = label;
+  result.voxels = voxels;
+  Surface& s = result.surface;
+  s.pair = o.pair;
+  s.selection = Selection::label(label);
+  s.mapping = Mapping::Midpoint;
+  placeSurface(source, std::move(mesh), Mapping::Midpoint, s.selection, 0.25, s);
+  if (o.figures) addFigures(s);
+  return result;
+}
+
+/// Every boundary of the selected labels: one scan of the cubes converts them all
+/// (ScanLabels.h), then each label's mesh is placed, labels in parallel.
+template <class T>
+std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& source, const LabelOptions& o,
+                                  tbb::task_arena& arena, int parts) {
+  if (o.labels.kind == LabelSelection::Kind::List) requireListable<T>(o.labels, o.background);
+  if (o.labels.kind == LabelSelection::Kind::Range) requireNonEmptyRange(o.labels);
+  const WantedLabel<T> wanted(o.labels);
+  LabelScan<T> scan = scanLabelSurfaces(image, T(o.background), wanted, o.pair, arena, parts);
+
+  requireExactLabels(scan.labels);
+  const std::vector<std::size_t> selected = selectLabels(scan.labels, o.labels, o.background);
+  // Largest first, so that the last to finish are small.
+  std::vector<std::size_t> order(selected.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return scan.meshes[selected[a]].surfels.size() > scan.meshes[selected[b]].surfels.size();
+  });
+  std::vector<LabelSurface> out(selected.size());
+  forEachIndex(arena, order.size(), [&](std::size_t k) {
+    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+    const std::size_t r = order[k], i = selected[r];
+    out[r] = labelSurface(source, double(scan.labels[i]), scan.voxels[i], std::move(scan.meshes[i]), o);
+    Surface& s = out[r].surface;
+    std::size_t boundaries = s.components.size();
+    if (!o.figures) triangleComponents(s.vertices.size(), s.triangles, boundaries);
+    s.boundariesInImage = boundaries;
+  });
+  return out;
+}
+
 template <class T>
 std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource& source, const LabelOptions& o) {
   if (!holdsValue<T>(o.background))
@@ -142,9 +233,14 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
   const Dims dims = view.dims;
   const VolumeRef<T> image(static_cast<const T*>(view.data), dims, view.strides[0], view.strides[1], view.strides[2]);
   tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
-
-  // 1. One scan of the rows, slabs of planes in parallel.
   const int parts = o.threads == 1 ? 1 : std::min(dims.nz, 4 * std::max(1, arena.max_concurrency()));
+  const bool fromSeeds = !o.seeds.empty();
+  if (fromSeeds && o.boundaries == LabelBoundaries::Largest)
+    throw InvalidInput("seeds select their own boundaries: give seeds or the largest boundary, not both");
+  if (!fromSeeds && o.boundaries == LabelBoundaries::All) return scanAll(image, source, o, arena, parts);
+
+  // Some boundaries of each label: one scan of the rows for seeds, slabs of planes in
+  // parallel, then each label's boundaries tracked.
   std::vector<LabelSeeds<T>> slabs(std::size_t(std::max(parts, 1)));
   forEachIndex(arena, slabs.size(), [&](std::size_t k) {
     const int z0 = int(std::int64_t(dims.nz) * std::int64_t(k) / std::int64_t(slabs.size()));
@@ -152,14 +248,11 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
     slabs[k] = scanLabelSeeds(image, T(o.background), z0, z1);
   });
   LabelSeeds<T> seeds = mergeLabelSeeds(std::move(slabs));
-  if constexpr (sizeof(T) == 8)
-    for (T L : seeds.labels)
-      if (!(std::abs(double(L)) <= std::ldexp(1.0, 53)))
-        throw InvalidInput("label " + std::to_string(L) + " is beyond 2^53: labels must be exact as doubles");
+  requireExactLabels(seeds.labels);
 
-  std::vector<std::size_t> selected = selectLabels(seeds, o.labels, o.background);
+  std::vector<std::size_t> selected = selectLabels(seeds.labels, o.labels, o.background);
   const std::vector<std::vector<std::size_t>> wanted = wantedSeeds(image, seeds, selected, o);
-  if (o.boundaries == LabelBoundaries::FromSeeds)  // only the labels of the seeds
+  if (fromSeeds)  // only the labels of the seeds
     std::erase_if(selected, [&](std::size_t i) { return wanted[i].empty(); });
 
   // 2. The labels, largest first so that the last to finish are small.
@@ -197,16 +290,8 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
       throw InternalError(e.what());
     }
     std::vector<std::uint64_t>().swap(seeds.surfels[i]);  // done with them: the output grows
-    LabelSurface& result = out[r];
-    result.label = selection.value;
-    result.voxels = seeds.voxels[i];
-    Surface& s = result.surface;
-    s.pair = o.pair;
-    s.selection = selection;
-    s.mapping = Mapping::Midpoint;
-    s.boundariesInImage = o.boundaries == LabelBoundaries::FromSeeds ? 0 : boundaries;
-    placeSurface(source, std::move(mesh), Mapping::Midpoint, selection, 0.25, s);
-    if (o.figures) addFigures(s);
+    out[r] = labelSurface(source, selection.value, seeds.voxels[i], std::move(mesh), o);
+    out[r].surface.boundariesInImage = fromSeeds ? 0 : boundaries;
   });
   return out;
 }

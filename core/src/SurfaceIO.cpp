@@ -1,10 +1,9 @@
 // writeSurface: a Surface through the converter's manifold check and OpenMesh's writers;
-// writeLabelSurfaces: label surfaces as one PLY with label properties, through the same writer.
-#include <bit>
-#include <cmath>
-#include <cstdio>
-#include <fstream>
+// writeLabelSurfaces: label surfaces as one PLY with label properties, through the same binary
+// PLY writer (converter/MeshIO.h writeLabelledTriangles).
+#include <cstdint>
 #include <limits>
+#include <stdexcept>
 
 #include "Errors.h"
 #include "Extract.h"
@@ -34,12 +33,6 @@ void writeSurface(const Surface& surface, const std::string& path, bool binary) 
 
 namespace {
 
-template <class T>
-void put(std::ofstream& out, T value) {
-  static_assert(std::endian::native == std::endian::little, "the PLY writer assumes a little-endian host");
-  out.write(reinterpret_cast<const char*>(&value), sizeof value);
-}
-
 /// A label as the PLY int property (labels beyond int32 do not fit it).
 std::int32_t plyLabel(double label) {
   if (!(label >= std::numeric_limits<std::int32_t>::min() && label <= std::numeric_limits<std::int32_t>::max()))
@@ -50,48 +43,14 @@ std::int32_t plyLabel(double label) {
 }  // namespace
 
 void writeLabelSurfaces(const std::vector<LabelSurface>& surfaces, const std::string& path, bool binary) {
-  std::size_t vertices = 0, faces = 0;
-  for (const LabelSurface& ls : surfaces) {
-    plyLabel(ls.label);
-    vertices += ls.surface.vertices.size();
-    faces += ls.surface.triangles.size();
+  std::vector<LabelledMesh> meshes;
+  for (const LabelSurface& ls : surfaces)
+    meshes.push_back({&ls.surface.vertices, &ls.surface.triangles, plyLabel(ls.label)});
+  try {
+    writeLabelledTriangles(meshes, path, binary);
+  } catch (const std::invalid_argument& e) {
+    throw InvalidInput(e.what());
   }
-  if (vertices > std::numeric_limits<std::uint32_t>::max())
-    throw InvalidInput("cannot write '" + path + "': more than 2^32 - 1 vertices in one PLY");
-  writeFileAtomically(path, [&](const std::string& temporary) {
-    std::ofstream out(temporary, std::ios::binary);
-    out << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
-        << "comment surftrack label surfaces: one closed surface per label\n"
-        << "element vertex " << vertices << "\nproperty double x\nproperty double y\nproperty double z\n"
-        << "property int label\nelement face " << faces << "\nproperty list uchar uint vertex_indices\n"
-        << "property int label\nend_header\n";
-    out.precision(17);
-    for (const LabelSurface& ls : surfaces) {
-      const std::int32_t label = plyLabel(ls.label);
-      for (const auto& p : ls.surface.vertices) {
-        if (binary) {
-          put(out, p[0]), put(out, p[1]), put(out, p[2]), put(out, label);
-        } else {
-          out << p[0] << ' ' << p[1] << ' ' << p[2] << ' ' << label << '\n';
-        }
-      }
-    }
-    std::uint32_t offset = 0;
-    for (const LabelSurface& ls : surfaces) {
-      const std::int32_t label = plyLabel(ls.label);
-      for (const auto& t : ls.surface.triangles) {
-        if (binary) {
-          put(out, std::uint8_t(3)), put(out, t[0] + offset), put(out, t[1] + offset), put(out, t[2] + offset);
-          put(out, label);
-        } else {
-          out << "3 " << t[0] + offset << ' ' << t[1] + offset << ' ' << t[2] + offset << ' ' << label << '\n';
-        }
-      }
-      offset += std::uint32_t(ls.surface.vertices.size());
-    }
-    out.close();
-    return bool(out);
-  });
 }
 
 }  // namespace surftrack

@@ -243,9 +243,7 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
   if (selectionKind == "list") o.labels = LabelSelection::list(std::move(labels));
   else if (selectionKind == "range") o.labels = LabelSelection::range(range[0], range[1]);
   o.background = background;
-  o.boundaries = boundaries == "largest" ? LabelBoundaries::Largest
-                 : seeds.empty()         ? LabelBoundaries::All
-                                         : LabelBoundaries::FromSeeds;
+  o.boundaries = boundaries == "largest" ? LabelBoundaries::Largest : LabelBoundaries::All;
   for (const auto& a : seeds) {
     Voxel v;
     for (int e = 0; e < 3; ++e) v[e] = a[order[e]];

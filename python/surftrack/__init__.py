@@ -260,8 +260,9 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
                    direction=None, affine=None, threads: int = 0, figures: bool = True) -> dict:
     """Every label of an integer label image as a closed surface: a dict label -> Surface.
 
-    One scan of the image finds every label's boundaries; each label's are tracked and
-    converted, labels in parallel (``threads``, 0: all cores). Vertices are surfel midpoints,
+    One scan of the cubes triangulates every boundary of every label at once ("largest" and
+    ``seeds``: a scan for seeds, then each label's boundaries tracked, labels in parallel;
+    ``threads``, 0: all cores). Vertices are surfel midpoints,
     so two touching labels share their interface vertices exactly. ``only`` lists the labels
     wanted (each must occur), ``label_range=(first, last)`` takes those in between; the
     ``background`` label gets no surface. ``boundaries`` is "all" (default) or "largest" per

@@ -40,11 +40,11 @@ struct LabelSelection {
   static LabelSelection range(double first, double last) { return {Kind::Range, {}, first, last}; }
 };
 
-/// Which boundaries of each label to extract.
+/// Which boundaries of each label to extract, when LabelOptions::seeds is empty (seeds select
+/// their own boundaries).
 enum class LabelBoundaries {
-  All,       ///< every boundary of the label
-  Largest,   ///< the boundary with the most surfels (ties: the first met by the scan)
-  FromSeeds  ///< the boundaries reached from LabelOptions::seeds (only the seeds' labels)
+  All,     ///< every boundary of the label
+  Largest  ///< the boundary with the most surfels (ties: the first met by the scan)
 };
 
 struct LabelOptions {
@@ -52,9 +52,10 @@ struct LabelOptions {
   /// The label of no surface: its voxels are 0-voxels of every label.
   double background = 0;
   LabelBoundaries boundaries = LabelBoundaries::All;
-  /// FromSeeds: each voxel, of label L, selects the boundary of L through the surfel (c, c + x)
-  /// where c is the last voxel of L met walking from the seed along +x (SeedRule::fromVoxel's
-  /// first ray). A seed's label must be selected and not the background.
+  /// If not empty, only the boundaries these voxels select, and only their labels: each voxel,
+  /// of label L, selects the boundary of L through the surfel (c, c + x) where c is the last
+  /// voxel of L met walking from the seed along +x (SeedRule::ray's first ray). A seed's label
+  /// must be selected and not the background; `boundaries` must be All.
   std::vector<Voxel> seeds;
   AdjacencyPair pair = AdjacencyPair::k26_6;
   /// Threads for the scan and for the labels: 0 for all cores. The surfaces are the same for any
@@ -72,7 +73,7 @@ struct LabelSurface {
   double label = 0;
   std::uint64_t voxels = 0;  ///< voxels of the label in the image
   /// selection = Selection::label(label), mapping Midpoint; boundariesInImage: every boundary
-  /// of the label for LabelBoundaries::All and Largest, 0 (not counted) for FromSeeds.
+  /// of the label for LabelBoundaries::All and Largest, 0 (not counted) with seeds.
   Surface surface;
 };
 
@@ -80,16 +81,18 @@ struct LabelSurface {
 /// \pre the labels of the image are exactly representable as doubles (|L| <= 2^53).
 /// \throw InvalidInput for a float volume, a selected label that is not a value of the type,
 ///        does not occur or is the background, a range or an image with no label to extract,
-///        a seed outside the domain or on the background or an unselected label, a label
-///        beyond 2^53.
+///        a seed outside the domain or on the background or an unselected label, seeds with
+///        LabelBoundaries::Largest, a label beyond 2^53.
 /// \throw Cancelled when options.cancel is raised.
 /// \throw InternalError when an engine invariant fails (a bug).
 std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options);
 
 /// Writes every surface into one PLY file (binary little-endian, or text): the vertices of each
-/// label in turn (a vertex on an interface once per label it bounds), with an int property
-/// `label` on every vertex and every face. Through a temporary file renamed over `path`.
-/// \throw std::runtime_error naming the path when it cannot be written.
+/// label in turn (float x, y, z; a vertex on an interface once per label it bounds), the faces
+/// (int indices), with an int property `label` on every vertex and every face. Through a
+/// temporary file renamed over `path`.
+/// \throw InvalidInput for a label beyond int32 or more than 2^31 - 1 vertices;
+///        std::runtime_error naming the path when it cannot be written.
 void writeLabelSurfaces(const std::vector<LabelSurface>& surfaces, const std::string& path, bool binary = true);
 
 }  // namespace surftrack
