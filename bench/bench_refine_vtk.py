@@ -3,10 +3,12 @@
 "Smoothing and decimation").
 
 Runs bench_refine (the binary clean sphere of Figure 9, R = 0.4 q: its midpoint mesh, smooth()
-and decimate()), then VTK on the same midpoint mesh: vtkWindowedSincPolyDataFilter with the same
-number of iterations, and vtkQuadricDecimation with the same reduction. Reports for each result
-the RMS of |x - c| - R over the vertices, the enclosed volume against the midpoint mesh's, the
-times, and, from surftrack_mesh_check (CGAL, tests/mesh_check.cpp), closedness, genus and
+and decimate(); or, with --input FILE --iso V, the largest boundary of a volume file), then VTK
+on the same mesh: vtkWindowedSincPolyDataFilter with the same number of iterations (none with
+--iterations 0: both decimate the extracted mesh), and vtkQuadricDecimation with the same
+reduction. Reports for each result the RMS of |x - c| - R over the vertices (the sphere only),
+the enclosed volume against the extracted mesh's, the times, and, from surftrack_mesh_check
+(CGAL, tests/mesh_check.cpp; --skip-checks leaves it out), closedness, genus and
 self-intersecting triangle pairs. Renders a before/after PNG with gnuplot.
 
 Needs Debian's /usr/bin/python3 with numpy and vtk 9 (python3-vtk9).
@@ -91,16 +93,22 @@ def main():
     ap.add_argument("--passband", type=float, default=0.1, help="vtkWindowedSincPolyDataFilter pass band (default 0.1)")
     ap.add_argument("--out", default="bench-refine", help="directory for the meshes (default bench-refine)")
     ap.add_argument("--png", help="write the before/after picture here")
+    ap.add_argument("--input", help="a volume file instead of the sphere (its largest boundary)")
+    ap.add_argument("--iso", type=float, default=0.0, help="the iso-value (threshold) for --input")
+    ap.add_argument("--skip-checks", action="store_true", help="no CGAL checks (large meshes)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     bench = os.path.join(a.build, "bench", "bench_refine")
     tool = os.path.join(a.build, "tests", "surftrack_mesh_check")
-    ours = json.loads(subprocess.run([bench, "--size", str(a.size), "--iterations", str(a.iterations),
-                                      "--max-error", str(a.max_error), "--reduce", str(a.reduce), "--out", a.out],
-                                     check=True, capture_output=True, text=True).stdout)
+    command = [bench, "--size", str(a.size), "--iterations", str(a.iterations), "--max-error", str(a.max_error),
+               "--reduce", str(a.reduce), "--out", a.out]
+    if a.input:
+        command += ["--input", a.input, "--iso", str(a.iso)]
+    ours = json.loads(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
     centre, radius = np.full(3, ours["centre"]), ours["radius"]
     midpoint = read_ply(os.path.join(a.out, "sphere-midpoint.ply"))
 
+    smoothing = a.iterations > 0
     sinc = vtk.vtkWindowedSincPolyDataFilter()
     sinc.SetInputData(midpoint)
     sinc.SetNumberOfIterations(a.iterations)
@@ -109,11 +117,14 @@ def main():
     sinc.FeatureEdgeSmoothingOff()
     sinc.NonManifoldSmoothingOn()
     sinc.NormalizeCoordinatesOn()
-    t0 = time.perf_counter()
-    sinc.Update()
-    sinc_s = time.perf_counter() - t0
-    smoothed = sinc.GetOutput()
-    write_ply(smoothed, os.path.join(a.out, "vtk-sinc.ply"))
+    sinc_s = None
+    smoothed = midpoint
+    if smoothing:
+        t0 = time.perf_counter()
+        sinc.Update()
+        sinc_s = time.perf_counter() - t0
+        smoothed = sinc.GetOutput()
+        write_ply(smoothed, os.path.join(a.out, "vtk-sinc.ply"))
 
     decimation = vtk.vtkQuadricDecimation()
     decimation.SetInputData(smoothed)
@@ -126,30 +137,36 @@ def main():
 
     base = figures(midpoint, centre, radius)
     rows = []
-    for name, path, secs in [
-            ("midpoint mesh", "sphere-midpoint.ply", None),
-            ("surftrack smooth()", "sphere-smoothed.ply", ours["smooth_s"]["wall"]),
-            ("VTK windowed sinc", "vtk-sinc.ply", sinc_s),
-            ("surftrack decimate()", "sphere-decimated.ply", ours["decimate_s"]["wall"]),
-            ("VTK quadric decimation", "vtk-quadric.ply", quadric_s)]:
+    results = [("extracted mesh" if a.input else "midpoint mesh", "sphere-midpoint.ply", None)]
+    if smoothing:
+        results += [("surftrack smooth()", "sphere-smoothed.ply", ours["smooth_s"]["wall"]),
+                    ("VTK windowed sinc", "vtk-sinc.ply", sinc_s)]
+    results += [("surftrack decimate()", "sphere-decimated.ply", ours["decimate_s"]["wall"]),
+                ("VTK quadric decimation", "vtk-quadric.ply", quadric_s)]
+    for name, path, secs in results:
         poly = read_ply(os.path.join(a.out, path))
         f = figures(poly, centre, radius)
-        c = check(tool, os.path.join(a.out, path))
+        c = ({"genus": None, "closed_oriented": None, "manifold": None, "self_intersecting_pairs": -1}
+             if a.skip_checks else check(tool, os.path.join(a.out, path)))
         rows.append({"result": name, "triangles": f["triangles"], "rms": f["rms"],
                      "rms_drop": base["rms"] / f["rms"] if f["rms"] > 0 else None,
                      "volume_change_pct": 100 * (f["volume"] - base["volume"]) / base["volume"],
                      "seconds": secs, "genus": c["genus"], "closed_manifold": c["closed_oriented"] and c["manifold"],
                      "self_intersecting_pairs": c["self_intersecting_pairs"]})
-    print(f"binary clean sphere q = {a.size}, R = {radius:g}; {a.iterations} iterations; reduce {a.reduce}; "
+    what = f"{a.input} at {a.iso:g}" if a.input else f"binary clean sphere q = {a.size}, R = {radius:g}"
+    print(f"{what}; {a.iterations} iterations; reduce {a.reduce}; "
           f"surftrack max error {a.max_error}; load average {os.getloadavg()[0]:.2f}")
     print(f"{'result':24s} {'triangles':>9s} {'RMS':>8s} {'drop':>6s} {'volume':>9s} {'time s':>7s} "
           f"{'genus':>6s} {'manifold':>8s} {'self-int':>8s}")
     for r in rows:
         secs = "" if r["seconds"] is None else f"{r['seconds']:.3f}"
         drop = "" if r["rms_drop"] is None else f"{r['rms_drop']:.2f}x"
-        print(f"{r['result']:24s} {r['triangles']:9d} {r['rms']:8.4f} {drop:>6s} {r['volume_change_pct']:+8.3f}% "
+        if a.input:
+            drop = ""
+        print(f"{r['result']:24s} {r['triangles']:9d} {r['rms'] if not a.input else float('nan'):8.4f} {drop:>6s} "
+              f"{r['volume_change_pct']:+8.3f}% "
               f"{secs:>7s} {str(r['genus']):>6s} {str(r['closed_manifold']):>8s} {r['self_intersecting_pairs']:8d}")
-    if a.png:
+    if a.png and smoothing and not a.input:
         render([read_ply(os.path.join(a.out, p)) for p in ("sphere-midpoint.ply", "sphere-smoothed.ply",
                                                             "vtk-sinc.ply", "sphere-decimated.ply")],
                ["midpoint (terraced)", "surftrack smooth()", "VTK windowed sinc", "surftrack decimate()"], a.png,

@@ -13,20 +13,26 @@ std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priorit
   struct Candidate {
     float priority;
     int halfedge;
-    std::uint32_t stamp;  // of the halfedge's from-vertex when it was evaluated
+    std::uint32_t version;  // of the halfedge when it was evaluated
     bool operator>(const Candidate& o) const {
       return priority != o.priority ? priority > o.priority : halfedge > o.halfedge;
     }
   };
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap;
-  std::vector<std::uint32_t> stamp(mesh_.n_vertices(), 0);
+  // A halfedge's entry is current while its version is; a halfedge found illegal when it came
+  // out is `dropped` until a collapse changes the faces around its from-vertex.
+  std::vector<std::uint32_t> version(mesh_.n_halfedges(), 0);
+  std::vector<char> dropped(mesh_.n_halfedges(), 0);
   auto evaluate = [&](typename MeshT::HalfedgeHandle h) {
     if (mesh_.status(h).deleted()) return;
+    // Legality (OpenMesh's is_collapse_ok and the modules) is asked when the candidate comes
+    // out: asking it of every candidate that goes in would be wasted on most of them.
+    const std::uint32_t v = ++version[h.idx()];
+    dropped[h.idx()] = 0;
     CollapseInfo ci(mesh_, h);
-    if (!this->is_collapse_legal(ci)) return;
     const float p = priority(ci);
     if (p == float(OpenMesh::Decimater::ModBaseT<MeshT>::ILLEGAL_COLLAPSE)) return;
-    heap.push({p, h.idx(), stamp[ci.v0.idx()]});
+    heap.push({p, h.idx(), v});
   };
   for (auto h : mesh_.halfedges()) evaluate(h);
 
@@ -35,14 +41,19 @@ std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priorit
     const Candidate c = heap.top();
     heap.pop();
     const typename MeshT::HalfedgeHandle h(c.halfedge);
-    if (mesh_.status(h).deleted()) continue;
+    if (mesh_.status(h).deleted() || version[c.halfedge] != c.version) continue;
     CollapseInfo ci(mesh_, h);
-    if (stamp[ci.v0.idx()] != c.stamp) continue;  // re-evaluated when its vertex changed
-    if (!this->is_collapse_legal(ci)) continue;
+    if (!this->is_collapse_legal(ci)) {
+      dropped[c.halfedge] = 1;
+      continue;
+    }
     const float p = this->collapse_priority(ci);  // every module, now
-    if (p == float(OpenMesh::Decimater::ModBaseT<MeshT>::ILLEGAL_COLLAPSE)) continue;
+    if (p == float(OpenMesh::Decimater::ModBaseT<MeshT>::ILLEGAL_COLLAPSE)) {
+      dropped[c.halfedge] = 1;
+      continue;
+    }
     if (p > c.priority) {  // grown since (a module's state changed): back in its place
-      heap.push({p, c.halfedge, c.stamp});
+      heap.push({p, c.halfedge, c.version});
       continue;
     }
     this->preprocess_collapse(ci);
@@ -52,13 +63,16 @@ std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priorit
     if (mesh_.has_face_normals())
       for (auto f : mesh_.vf_range(ci.v1)) mesh_.set_normal(f, mesh_.calc_face_normal(f));
     this->postprocess_collapse(ci);
-    // The checks of a halfedge read the faces around its from-vertex: those of v1 and its
-    // ring changed.
-    ++stamp[ci.v1.idx()];
-    for (auto w : mesh_.vv_range(ci.v1)) ++stamp[w.idx()];
-    for (auto h2 : mesh_.voh_range(ci.v1)) evaluate(h2);
+    // The priority of a halfedge reads its two vertices (the quadric of v1 has changed): the
+    // halfedges into and out of v1 go in again. The checks of a halfedge read the faces around
+    // its from-vertex, which changed for v1 and its ring: their dropped halfedges go in again.
+    for (auto h2 : mesh_.voh_range(ci.v1)) {
+      evaluate(h2);
+      evaluate(mesh_.opposite_halfedge_handle(h2));
+    }
     for (auto w : mesh_.vv_range(ci.v1))
-      for (auto h2 : mesh_.voh_range(w)) evaluate(h2);
+      for (auto h2 : mesh_.voh_range(w))
+        if (dropped[h2.idx()]) evaluate(h2);
   }
   return collapses;
 }
