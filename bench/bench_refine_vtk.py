@@ -9,7 +9,8 @@ on the same mesh: vtkWindowedSincPolyDataFilter with the same number of iteratio
 reduction. Reports for each result the RMS of |x - c| - R over the vertices (the sphere only),
 the enclosed volume against the extracted mesh's, the times, and, from surftrack_mesh_check
 (CGAL, tests/mesh_check.cpp; --skip-checks leaves it out), closedness, genus and
-self-intersecting triangle pairs. Renders a before/after PNG with gnuplot.
+self-intersecting triangle pairs. Times are wall and CPU seconds of the calls alone (surftrack's
+thread, VTK's process). Renders a before/after PNG with gnuplot.
 
 Needs Debian's /usr/bin/python3 with numpy and vtk 9 (python3-vtk9).
 """
@@ -117,33 +118,33 @@ def main():
     sinc.FeatureEdgeSmoothingOff()
     sinc.NonManifoldSmoothingOn()
     sinc.NormalizeCoordinatesOn()
-    sinc_s = None
+    sinc_s = sinc_cpu = None
     smoothed = midpoint
     if smoothing:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         sinc.Update()
-        sinc_s = time.perf_counter() - t0
+        sinc_s, sinc_cpu = time.perf_counter() - t0, time.process_time() - c0
         smoothed = sinc.GetOutput()
         write_ply(smoothed, os.path.join(a.out, "vtk-sinc.ply"))
 
     decimation = vtk.vtkQuadricDecimation()
     decimation.SetInputData(smoothed)
     decimation.SetTargetReduction(a.reduce)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     decimation.Update()
-    quadric_s = time.perf_counter() - t0
+    quadric_s, quadric_cpu = time.perf_counter() - t0, time.process_time() - c0
     decimated = decimation.GetOutput()
     write_ply(decimated, os.path.join(a.out, "vtk-quadric.ply"))
 
     base = figures(midpoint, centre, radius)
     rows = []
-    results = [("extracted mesh" if a.input else "midpoint mesh", "sphere-midpoint.ply", None)]
+    results = [("extracted mesh" if a.input else "midpoint mesh", "sphere-midpoint.ply", None, None)]
     if smoothing:
-        results += [("surftrack smooth()", "sphere-smoothed.ply", ours["smooth_s"]["wall"]),
-                    ("VTK windowed sinc", "vtk-sinc.ply", sinc_s)]
-    results += [("surftrack decimate()", "sphere-decimated.ply", ours["decimate_s"]["wall"]),
-                ("VTK quadric decimation", "vtk-quadric.ply", quadric_s)]
-    for name, path, secs in results:
+        results += [("surftrack smooth()", "sphere-smoothed.ply", ours["smooth_s"]["wall"], ours["smooth_s"]["cpu"]),
+                    ("VTK windowed sinc", "vtk-sinc.ply", sinc_s, sinc_cpu)]
+    results += [("surftrack decimate()", "sphere-decimated.ply", ours["decimate_s"]["wall"], ours["decimate_s"]["cpu"]),
+                ("VTK quadric decimation", "vtk-quadric.ply", quadric_s, quadric_cpu)]
+    for name, path, secs, cpu in results:
         poly = read_ply(os.path.join(a.out, path))
         f = figures(poly, centre, radius)
         c = ({"genus": None, "closed_oriented": None, "manifold": None, "self_intersecting_pairs": -1}
@@ -151,21 +152,22 @@ def main():
         rows.append({"result": name, "triangles": f["triangles"], "rms": f["rms"],
                      "rms_drop": base["rms"] / f["rms"] if f["rms"] > 0 else None,
                      "volume_change_pct": 100 * (f["volume"] - base["volume"]) / base["volume"],
-                     "seconds": secs, "genus": c["genus"], "closed_manifold": c["closed_oriented"] and c["manifold"],
+                     "seconds": secs, "cpu": cpu, "genus": c["genus"], "closed_manifold": c["closed_oriented"] and c["manifold"],
                      "self_intersecting_pairs": c["self_intersecting_pairs"]})
     what = f"{a.input} at {a.iso:g}" if a.input else f"binary clean sphere q = {a.size}, R = {radius:g}"
     print(f"{what}; {a.iterations} iterations; reduce {a.reduce}; "
           f"surftrack max error {a.max_error}; load average {os.getloadavg()[0]:.2f}")
-    print(f"{'result':24s} {'triangles':>9s} {'RMS':>8s} {'drop':>6s} {'volume':>9s} {'time s':>7s} "
+    print(f"{'result':24s} {'triangles':>9s} {'RMS':>8s} {'drop':>6s} {'volume':>9s} {'time s':>7s} {'cpu s':>7s} "
           f"{'genus':>6s} {'manifold':>8s} {'self-int':>8s}")
     for r in rows:
         secs = "" if r["seconds"] is None else f"{r['seconds']:.3f}"
+        cpu = "" if r["cpu"] is None else f"{r['cpu']:.3f}"
         drop = "" if r["rms_drop"] is None else f"{r['rms_drop']:.2f}x"
         if a.input:
             drop = ""
         print(f"{r['result']:24s} {r['triangles']:9d} {r['rms'] if not a.input else float('nan'):8.4f} {drop:>6s} "
               f"{r['volume_change_pct']:+8.3f}% "
-              f"{secs:>7s} {str(r['genus']):>6s} {str(r['closed_manifold']):>8s} {r['self_intersecting_pairs']:8d}")
+              f"{secs:>7s} {cpu:>7s} {str(r['genus']):>6s} {str(r['closed_manifold']):>8s} {r['self_intersecting_pairs']:8d}")
     if a.png and smoothing and not a.input:
         render([read_ply(os.path.join(a.out, p)) for p in ("sphere-midpoint.ply", "sphere-smoothed.ply",
                                                             "vtk-sinc.ply", "sphere-decimated.ply")],

@@ -2,7 +2,8 @@
 #pragma once
 
 #include <cstdint>
-#include <queue>
+#include <algorithm>
+#include <functional>
 #include <vector>
 
 namespace surftrack::refine {
@@ -18,11 +19,18 @@ std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priorit
       return priority != o.priority ? priority > o.priority : halfedge > o.halfedge;
     }
   };
-  std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap;
+  // A min-heap (std::push_heap and std::pop_heap with std::greater) over a vector, so that the
+  // first candidates of all halfedges are heaped at once.
+  std::vector<Candidate> heap;
+  auto push = [&](const Candidate& c) {
+    heap.push_back(c);
+    std::push_heap(heap.begin(), heap.end(), std::greater<Candidate>());
+  };
   // A halfedge's entry is current while its version is; a halfedge found illegal when it came
   // out is `dropped` until a collapse changes the faces around its from-vertex.
   std::vector<std::uint32_t> version(mesh_.n_halfedges(), 0);
   std::vector<char> dropped(mesh_.n_halfedges(), 0);
+  bool initial = true;  // the first evaluations go in unheaped
   auto evaluate = [&](typename MeshT::HalfedgeHandle h) {
     if (mesh_.status(h).deleted()) return;
     // Legality (OpenMesh's is_collapse_ok and the modules) is asked when the candidate comes
@@ -32,14 +40,32 @@ std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priorit
     CollapseInfo ci(mesh_, h);
     const float p = priority(ci);
     if (p == float(OpenMesh::Decimater::ModBaseT<MeshT>::ILLEGAL_COLLAPSE)) return;
-    heap.push({p, h.idx(), v});
+    if (initial) heap.push_back({p, h.idx(), v});
+    else push({p, h.idx(), v});
   };
+  heap.reserve(mesh_.n_halfedges());
   for (auto h : mesh_.halfedges()) evaluate(h);
+  std::make_heap(heap.begin(), heap.end(), std::greater<Candidate>());
+  initial = false;
 
   std::size_t collapses = 0, nf = mesh_.n_faces();
+  // Entries of deleted halfedges and superseded ones stay in the heap until they come out;
+  // when they outnumber the live halfedges (which have one current entry at most), they are
+  // swept out at once.
+  std::size_t liveHalfedges = mesh_.n_halfedges();
   while (nf > faces && !heap.empty()) {
-    const Candidate c = heap.top();
-    heap.pop();
+    if (heap.size() > 2 * liveHalfedges + 1024) {
+      heap.erase(std::remove_if(heap.begin(), heap.end(),
+                                [&](const Candidate& c) {
+                                  return mesh_.status(typename MeshT::HalfedgeHandle(c.halfedge)).deleted() ||
+                                         version[c.halfedge] != c.version;
+                                }),
+                 heap.end());
+      std::make_heap(heap.begin(), heap.end(), std::greater<Candidate>());
+    }
+    std::pop_heap(heap.begin(), heap.end(), std::greater<Candidate>());
+    const Candidate c = heap.back();
+    heap.pop_back();
     const typename MeshT::HalfedgeHandle h(c.halfedge);
     if (mesh_.status(h).deleted() || version[c.halfedge] != c.version) continue;
     CollapseInfo ci(mesh_, h);
@@ -53,12 +79,13 @@ std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priorit
       continue;
     }
     if (p > c.priority) {  // grown since (a module's state changed): back in its place
-      heap.push({p, c.halfedge, c.version});
+      push({p, c.halfedge, c.version});
       continue;
     }
     this->preprocess_collapse(ci);
     mesh_.collapse(h);
     ++collapses;
+    liveHalfedges -= 6;  // the collapsing edge and one of each pair of edges it merges
     nf -= (mesh_.is_boundary(ci.v0v1) || mesh_.is_boundary(ci.v1v0)) ? 1 : 2;
     if (mesh_.has_face_normals())
       for (auto f : mesh_.vf_range(ci.v1)) mesh_.set_normal(f, mesh_.calc_face_normal(f));

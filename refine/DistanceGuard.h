@@ -43,6 +43,7 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     MeshT& m = Base::mesh();
     if (!samplesOf_.is_valid()) m.add_property(samplesOf_);
     original_.clear();
+    originalBox_.clear();
     lastHit_ = 0;
     // Cells about twice the larger of the tolerance and the mean edge length: a triangle
     // meets a few cells, a query a few more.
@@ -52,6 +53,7 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
       const Triangle3 t = triangleOf(m, f);
       originalGrid_.insert(std::uint32_t(original_.size()), 0, boxOf(t));
       original_.push_back(t);
+      originalBox_.push_back(boxOf(t));
       auto& list = m.property(samplesOf_, f);
       list.clear();
       list.push_back({(t[0][0] + t[1][0] + t[2][0]) / 3, (t[0][1] + t[1][1] + t[2][1]) / 3,
@@ -73,17 +75,10 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     evaluated_ = ci.v0v1;
     created_.clear();
     createdFace_.clear();
-    for (auto f : m.vf_range(ci.v0)) {
-      if (f == ci.fl || f == ci.fr) continue;
-      Triangle3 t;
-      auto h = m.halfedge_handle(f);
-      for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) {
-        const VertexHandle v = m.to_vertex_handle(h);
-        t[k] = pointOf(v == ci.v0 ? ci.p1 : m.point(v));
-      }
+    forEachCreatedTriangle(m, ci, [&](FaceHandle f, const auto&, const Triangle3& t) {
       created_.push_back(t);
       createdFace_.push_back(f);
-    }
+    });
     const double e2 = tolerance_ * tolerance_;
     // Decimated -> original. The distance to a triangle is a convex function, so when the
     // three corners of a created triangle are within the tolerance of one original triangle,
@@ -153,8 +148,10 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
       return true;
     }
     bool found = false;
-    originalGrid_.near(boxOf({p, p, p}, tolerance_), [&](std::uint32_t id, std::uint32_t) {
-      if (!found && squaredDistanceToTriangle(p, original_[id]) <= e2) {
+    const Box3 query = boxOf({p, p, p}, tolerance_);
+    originalGrid_.near(query, [&](std::uint32_t id, std::uint32_t) {
+      // Only a triangle whose box meets the query box can be within the tolerance.
+      if (!found && originalBox_[id].meets(query) && squaredDistanceToTriangle(p, original_[id]) <= e2) {
         found = true;
         lastHit_ = id;
       }
@@ -183,6 +180,7 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
 
   double tolerance_ = 1;
   std::vector<Triangle3> original_, created_;
+  std::vector<Box3> originalBox_;
   std::vector<FaceHandle> createdFace_, assigned_;
   std::vector<Point3> pending_;
   std::uint32_t lastHit_ = 0;

@@ -40,18 +40,9 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     MeshT& m = Base::mesh();
     // The triangles the collapse creates: v0's faces but the two on the collapsing edge.
     created_.clear();
-    for (auto f : m.vf_range(ci.v0)) {
-      if (f == ci.fl || f == ci.fr) continue;
-      Face t;
-      auto h = m.halfedge_handle(f);
-      for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) {
-        const VertexHandle v = m.to_vertex_handle(h);
-        t.id[k] = v == ci.v0 ? ci.v1 : v;
-        t.p[k] = pointOf(v == ci.v0 ? ci.p1 : m.point(v));
-      }
-      t.box = boxOf(t.p, tolerance_);
-      created_.push_back(t);
-    }
+    forEachCreatedTriangle(m, ci, [&](FaceHandle, const std::array<VertexHandle, 3>& ids, const Triangle3& p) {
+      created_.push_back({ids, p, boxOf(p, tolerance_)});
+    });
     for (std::size_t i = 0; i < created_.size(); ++i) {
       for (std::size_t j = i + 1; j < created_.size(); ++j)
         if (created_[i].box.meets(created_[j].box) && meet(created_[i], created_[j])) return float(Base::ILLEGAL_COLLAPSE);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -25,6 +26,25 @@ Triangle3 triangleOf(const MeshT& m, typename MeshT::FaceHandle f) {
   Triangle3 t;
   for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) t[k] = pointOf(m.point(m.to_vertex_handle(h)));
   return t;
+}
+
+/// The triangles a halfedge collapse v0 -> v1 creates (docs/theory.md, section 10): v0's faces
+/// but the two on the collapsing edge, with v1 (at ci.p1) for v0. Calls fn(f, vertices, points)
+/// for each, f the face that becomes it.
+template <class MeshT, class CollapseInfo, class Fn>
+void forEachCreatedTriangle(const MeshT& m, const CollapseInfo& ci, Fn&& fn) {
+  for (auto f : m.vf_range(ci.v0)) {
+    if (f == ci.fl || f == ci.fr) continue;
+    std::array<typename MeshT::VertexHandle, 3> vertices;
+    Triangle3 points;
+    auto h = m.halfedge_handle(f);
+    for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) {
+      const auto v = m.to_vertex_handle(h);
+      vertices[k] = v == ci.v0 ? ci.v1 : v;
+      points[k] = pointOf(v == ci.v0 ? ci.p1 : m.point(v));
+    }
+    fn(f, vertices, points);
+  }
 }
 
 /// The mean length of the mesh's (undeleted) edges; 1 without edges.
