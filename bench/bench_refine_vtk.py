@@ -91,6 +91,8 @@ def main():
     ap.add_argument("--iterations", type=int, default=50, help="smoothing iterations, both tools (default 50)")
     ap.add_argument("--max-error", type=float, default=0.5, help="surftrack's decimation bound, voxels (default 0.5)")
     ap.add_argument("--reduce", type=float, default=0.9, help="fraction of triangles removed, both tools (default 0.9)")
+    ap.add_argument("--lambda", dest="lam", type=float, help="surftrack's Taubin lambda (default: SmoothOptions')")
+    ap.add_argument("--mu", type=float, help="surftrack's Taubin mu (default: SmoothOptions')")
     ap.add_argument("--passband", type=float, default=0.1, help="vtkWindowedSincPolyDataFilter pass band (default 0.1)")
     ap.add_argument("--out", default="bench-refine", help="directory for the meshes (default bench-refine)")
     ap.add_argument("--png", help="write the before/after picture here")
@@ -105,6 +107,10 @@ def main():
                "--reduce", str(a.reduce), "--out", a.out]
     if a.input:
         command += ["--input", a.input, "--iso", str(a.iso)]
+    if a.lam is not None:
+        command += ["--lambda", str(a.lam)]
+    if a.mu is not None:
+        command += ["--mu", str(a.mu)]
     ours = json.loads(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
     centre, radius = np.full(3, ours["centre"]), ours["radius"]
     midpoint = read_ply(os.path.join(a.out, "sphere-midpoint.ply"))
@@ -155,7 +161,8 @@ def main():
                      "seconds": secs, "cpu": cpu, "genus": c["genus"], "closed_manifold": c["closed_oriented"] and c["manifold"],
                      "self_intersecting_pairs": c["self_intersecting_pairs"]})
     what = f"{a.input} at {a.iso:g}" if a.input else f"binary clean sphere q = {a.size}, R = {radius:g}"
-    print(f"{what}; {a.iterations} iterations; reduce {a.reduce}; "
+    taubin = "" if a.lam is None and a.mu is None else f" (surftrack lambda {a.lam}, mu {a.mu})"
+    print(f"{what}; {a.iterations} iterations{taubin}; reduce {a.reduce}; "
           f"surftrack max error {a.max_error}; load average {os.getloadavg()[0]:.2f}")
     print(f"{'result':24s} {'triangles':>9s} {'RMS':>8s} {'drop':>6s} {'volume':>9s} {'time s':>7s} {'cpu s':>7s} "
           f"{'genus':>6s} {'manifold':>8s} {'self-int':>8s}")

@@ -15,8 +15,8 @@ namespace surftrack::refine {
 
 struct SmoothingParameters {
   int iterations = 20;    ///< lambda|mu pairs of passes
-  double lambda = 0.9;    ///< the shrinking pass's factor, in ]0, 1]
-  double mu = -0.91;      ///< the inflating pass's factor, with mu < -lambda < 0 (pass band 1/lambda + 1/mu = 0.012)
+  double lambda = 0.7;    ///< the shrinking pass's factor, in ]0, 1]
+  double mu = -0.73;      ///< the inflating pass's factor, with mu < -lambda < 0
   double epsilon = 1e-3;  ///< t stays in [epsilon, 1 - epsilon], epsilon in ]0, 0.5[
   int halvings = 4;       ///< step-back halvings of a vertex's move before it stays put
 };

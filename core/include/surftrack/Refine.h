@@ -21,8 +21,8 @@ namespace surftrack {
 
 struct SmoothOptions {
   int iterations = 20;    ///< Taubin lambda|mu pairs of passes (0: nothing moves)
-  double lambda = 0.9;    ///< the strength: the shrinking pass's factor, in ]0, 1]
-  double mu = -0.91;      ///< the inflating pass's factor, mu < -lambda, mu >= -1
+  double lambda = 0.7;    ///< the strength: the shrinking pass's factor, in ]0, 1]
+  double mu = -0.73;      ///< the inflating pass's factor, mu < -lambda, mu >= -1
   double epsilon = 1e-3;  ///< each vertex stays at t in [epsilon, 1 - epsilon] of its segment
 };
 
