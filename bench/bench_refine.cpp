@@ -1,8 +1,10 @@
 // Constrained smoothing and topology-safe decimation on the binary clean sphere (docs/
 // performance.md, "Smoothing and decimation"): the Figure 9 sphere without noise, thresholded
-// (R = 0.4 q), its midpoint mesh, then smooth() and decimate() of the front door. Prints one
-// JSON object: triangles, the RMS of |x - c| - R over the vertices, enclosed volumes, times;
-// writes the three meshes as PLY for bench_refine_vtk.py, which runs VTK on the same mesh.
+// (R = 0.4 q), its midpoint mesh, then smooth() and decimate() of the front door; or, with
+// --input, the largest boundary of a volume file at an iso-value (its default mapping). Prints
+// one JSON object: triangles, the RMS of |x - c| - R over the vertices (the sphere), enclosed
+// volumes, times; writes the three meshes as PLY for bench_refine_vtk.py, which runs VTK on the
+// same mesh.
 #include <surftrack/Extract.h>
 #include <surftrack/Refine.h>
 
@@ -13,6 +15,9 @@
 
 #include "BenchSupport.h"
 #include "Phantoms.h"
+#ifdef BENCH_REFINE_READS_VOLUMES
+#include "ReadVolume.h"
+#endif
 
 using namespace surftrack;
 
@@ -20,12 +25,13 @@ namespace {
 
 const char* kUsage =
     "usage: bench_refine [--size Q] [--iterations N] [--lambda L] [--mu M] [--max-error E]\n"
-    "                    [--reduce F] [--out DIR]\n"
+    "                    [--reduce F] [--out DIR] [--input FILE --iso V]\n"
     "  The binary clean sphere of Figure 9 (side Q, default 128, R = 0.4 Q), its midpoint mesh,\n"
-    "  smoothed with N Taubin iterations (default 50; lambda L, mu M: the defaults of\n"
-    "  SmoothOptions) and decimated within E (default 0.5\n"
-    "  voxel) removing F of the triangles (default 0.9). Writes DIR/sphere-{midpoint,smoothed,\n"
-    "  decimated}.ply (default DIR: .) and prints the figures as one JSON object.\n";
+    "  smoothed with N Taubin iterations (default 50, 0: no smoothing; lambda L, mu M: the\n"
+    "  defaults of SmoothOptions) and decimated within E (default 0.5 voxel) removing F of the\n"
+    "  triangles (default 0.9). With --input, the largest boundary of FILE at iso-value V\n"
+    "  (threshold, default mapping) instead, E in physical units. Writes DIR/sphere-{midpoint,\n"
+    "  smoothed,decimated}.ply (default DIR: .) and prints the figures as one JSON object.\n";
 
 struct Figures {
   std::size_t triangles = 0;
@@ -60,7 +66,8 @@ int main(int argc, char** argv) {
     int q = 128, iterations = 50;
     double maxError = 0.5, reduce = 0.9;
     SmoothOptions so;
-    std::string out = ".";
+    std::string out = ".", input;
+    double iso = 0;
     for (bench::Arguments args(argc, argv); args.next();) {
       if (args.isHelp()) {
         std::cout << kUsage;
@@ -79,23 +86,43 @@ int main(int argc, char** argv) {
         so.mu = std::stod(args.value());
       } else if (args.is("--out")) {
         out = args.value();
+      } else if (args.is("--input")) {
+        input = args.value();
+      } else if (args.is("--iso")) {
+        iso = std::stod(args.value());
       } else {
         args.unknown();
       }
     }
-    const NoisyPhantom sphere = makeNoisySphere(q, 0.0);
+    const NoisyPhantom sphere = makeNoisySphere(input.empty() ? q : 2, 0.0);
+    Surface s;
     ExtractOptions o;
-    o.selection = Selection::threshold(sphere.iso);
-    o.seed = SeedRule::fromSurfel(protocolSeed(sphere));
-    o.mapping = Mapping::Midpoint;
-    Surface s = extract(VolumeView::of(sphere.image.data().data(), sphere.image.dims()), o);
+    if (input.empty()) {
+      o.selection = Selection::threshold(sphere.iso);
+      o.seed = SeedRule::fromSurfel(protocolSeed(sphere));
+      o.mapping = Mapping::Midpoint;
+      s = extract(VolumeView::of(sphere.image.data().data(), sphere.image.dims()), o);
+    } else {
+#ifdef BENCH_REFINE_READS_VOLUMES
+      o.selection = Selection::threshold(iso);
+      o.seed = SeedRule::largest();
+      const io::AnyVolume volume = io::readVolume(input);
+      s = std::visit(
+          [&](const auto& image) {
+            return extract(VolumeView::of(image.data().data(), image.dims(), image.geometry()), o);
+          },
+          volume);
+#else
+      throw std::runtime_error("--input needs the io library (configure with the CLI)");
+#endif
+    }
     const Figures midpoint = figuresOf(s, sphere.centre, sphere.radius);
     writeSurface(s, out + "/sphere-midpoint.ply");
 
     so.iterations = iterations;
     SmoothReport sr;
     const double t0 = bench::wallSeconds(), c0 = bench::threadCpuSeconds();
-    sr = smooth(s, so);
+    if (iterations > 0) sr = smooth(s, so);
     const double smoothWall = bench::wallSeconds() - t0, smoothCpu = bench::threadCpuSeconds() - c0;
     const Figures smoothed = figuresOf(s, sphere.centre, sphere.radius);
     writeSurface(s, out + "/sphere-smoothed.ply");

@@ -3,11 +3,14 @@
 "Smoothing and decimation").
 
 Runs bench_refine (the binary clean sphere of Figure 9, R = 0.4 q: its midpoint mesh, smooth()
-and decimate()), then VTK on the same midpoint mesh: vtkWindowedSincPolyDataFilter with the same
-number of iterations, and vtkQuadricDecimation with the same reduction. Reports for each result
-the RMS of |x - c| - R over the vertices, the enclosed volume against the midpoint mesh's, the
-times, and, from surftrack_mesh_check (CGAL, tests/mesh_check.cpp), closedness, genus and
-self-intersecting triangle pairs. Renders a before/after PNG with gnuplot.
+and decimate(); or, with --input FILE --iso V, the largest boundary of a volume file), then VTK
+on the same mesh: vtkWindowedSincPolyDataFilter with the same number of iterations (none with
+--iterations 0: both decimate the extracted mesh), and vtkQuadricDecimation with the same
+reduction. Reports for each result the RMS of |x - c| - R over the vertices (the sphere only),
+the enclosed volume against the extracted mesh's, the times, and, from surftrack_mesh_check
+(CGAL, tests/mesh_check.cpp; --skip-checks leaves it out), closedness, genus and
+self-intersecting triangle pairs. Times are wall and CPU seconds of the calls alone (surftrack's
+thread, VTK's process). Renders a before/after PNG with gnuplot.
 
 Needs Debian's /usr/bin/python3 with numpy and vtk 9 (python3-vtk9).
 """
@@ -88,19 +91,31 @@ def main():
     ap.add_argument("--iterations", type=int, default=50, help="smoothing iterations, both tools (default 50)")
     ap.add_argument("--max-error", type=float, default=0.5, help="surftrack's decimation bound, voxels (default 0.5)")
     ap.add_argument("--reduce", type=float, default=0.9, help="fraction of triangles removed, both tools (default 0.9)")
+    ap.add_argument("--lambda", dest="lam", type=float, help="surftrack's Taubin lambda (default: SmoothOptions')")
+    ap.add_argument("--mu", type=float, help="surftrack's Taubin mu (default: SmoothOptions')")
     ap.add_argument("--passband", type=float, default=0.1, help="vtkWindowedSincPolyDataFilter pass band (default 0.1)")
     ap.add_argument("--out", default="bench-refine", help="directory for the meshes (default bench-refine)")
     ap.add_argument("--png", help="write the before/after picture here")
+    ap.add_argument("--input", help="a volume file instead of the sphere (its largest boundary)")
+    ap.add_argument("--iso", type=float, default=0.0, help="the iso-value (threshold) for --input")
+    ap.add_argument("--skip-checks", action="store_true", help="no CGAL checks (large meshes)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     bench = os.path.join(a.build, "bench", "bench_refine")
     tool = os.path.join(a.build, "tests", "surftrack_mesh_check")
-    ours = json.loads(subprocess.run([bench, "--size", str(a.size), "--iterations", str(a.iterations),
-                                      "--max-error", str(a.max_error), "--reduce", str(a.reduce), "--out", a.out],
-                                     check=True, capture_output=True, text=True).stdout)
+    command = [bench, "--size", str(a.size), "--iterations", str(a.iterations), "--max-error", str(a.max_error),
+               "--reduce", str(a.reduce), "--out", a.out]
+    if a.input:
+        command += ["--input", a.input, "--iso", str(a.iso)]
+    if a.lam is not None:
+        command += ["--lambda", str(a.lam)]
+    if a.mu is not None:
+        command += ["--mu", str(a.mu)]
+    ours = json.loads(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
     centre, radius = np.full(3, ours["centre"]), ours["radius"]
     midpoint = read_ply(os.path.join(a.out, "sphere-midpoint.ply"))
 
+    smoothing = a.iterations > 0
     sinc = vtk.vtkWindowedSincPolyDataFilter()
     sinc.SetInputData(midpoint)
     sinc.SetNumberOfIterations(a.iterations)
@@ -109,47 +124,58 @@ def main():
     sinc.FeatureEdgeSmoothingOff()
     sinc.NonManifoldSmoothingOn()
     sinc.NormalizeCoordinatesOn()
-    t0 = time.perf_counter()
-    sinc.Update()
-    sinc_s = time.perf_counter() - t0
-    smoothed = sinc.GetOutput()
-    write_ply(smoothed, os.path.join(a.out, "vtk-sinc.ply"))
+    sinc_s = sinc_cpu = None
+    smoothed = midpoint
+    if smoothing:
+        t0, c0 = time.perf_counter(), time.process_time()
+        sinc.Update()
+        sinc_s, sinc_cpu = time.perf_counter() - t0, time.process_time() - c0
+        smoothed = sinc.GetOutput()
+        write_ply(smoothed, os.path.join(a.out, "vtk-sinc.ply"))
 
     decimation = vtk.vtkQuadricDecimation()
     decimation.SetInputData(smoothed)
     decimation.SetTargetReduction(a.reduce)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     decimation.Update()
-    quadric_s = time.perf_counter() - t0
+    quadric_s, quadric_cpu = time.perf_counter() - t0, time.process_time() - c0
     decimated = decimation.GetOutput()
     write_ply(decimated, os.path.join(a.out, "vtk-quadric.ply"))
 
     base = figures(midpoint, centre, radius)
     rows = []
-    for name, path, secs in [
-            ("midpoint mesh", "sphere-midpoint.ply", None),
-            ("surftrack smooth()", "sphere-smoothed.ply", ours["smooth_s"]["wall"]),
-            ("VTK windowed sinc", "vtk-sinc.ply", sinc_s),
-            ("surftrack decimate()", "sphere-decimated.ply", ours["decimate_s"]["wall"]),
-            ("VTK quadric decimation", "vtk-quadric.ply", quadric_s)]:
+    results = [("extracted mesh" if a.input else "midpoint mesh", "sphere-midpoint.ply", None, None)]
+    if smoothing:
+        results += [("surftrack smooth()", "sphere-smoothed.ply", ours["smooth_s"]["wall"], ours["smooth_s"]["cpu"]),
+                    ("VTK windowed sinc", "vtk-sinc.ply", sinc_s, sinc_cpu)]
+    results += [("surftrack decimate()", "sphere-decimated.ply", ours["decimate_s"]["wall"], ours["decimate_s"]["cpu"]),
+                ("VTK quadric decimation", "vtk-quadric.ply", quadric_s, quadric_cpu)]
+    for name, path, secs, cpu in results:
         poly = read_ply(os.path.join(a.out, path))
         f = figures(poly, centre, radius)
-        c = check(tool, os.path.join(a.out, path))
+        c = ({"genus": None, "closed_oriented": None, "manifold": None, "self_intersecting_pairs": -1}
+             if a.skip_checks else check(tool, os.path.join(a.out, path)))
         rows.append({"result": name, "triangles": f["triangles"], "rms": f["rms"],
                      "rms_drop": base["rms"] / f["rms"] if f["rms"] > 0 else None,
                      "volume_change_pct": 100 * (f["volume"] - base["volume"]) / base["volume"],
-                     "seconds": secs, "genus": c["genus"], "closed_manifold": c["closed_oriented"] and c["manifold"],
+                     "seconds": secs, "cpu": cpu, "genus": c["genus"], "closed_manifold": c["closed_oriented"] and c["manifold"],
                      "self_intersecting_pairs": c["self_intersecting_pairs"]})
-    print(f"binary clean sphere q = {a.size}, R = {radius:g}; {a.iterations} iterations; reduce {a.reduce}; "
+    what = f"{a.input} at {a.iso:g}" if a.input else f"binary clean sphere q = {a.size}, R = {radius:g}"
+    taubin = "" if a.lam is None and a.mu is None else f" (surftrack lambda {a.lam}, mu {a.mu})"
+    print(f"{what}; {a.iterations} iterations{taubin}; reduce {a.reduce}; "
           f"surftrack max error {a.max_error}; load average {os.getloadavg()[0]:.2f}")
-    print(f"{'result':24s} {'triangles':>9s} {'RMS':>8s} {'drop':>6s} {'volume':>9s} {'time s':>7s} "
+    print(f"{'result':24s} {'triangles':>9s} {'RMS':>8s} {'drop':>6s} {'volume':>9s} {'time s':>7s} {'cpu s':>7s} "
           f"{'genus':>6s} {'manifold':>8s} {'self-int':>8s}")
     for r in rows:
         secs = "" if r["seconds"] is None else f"{r['seconds']:.3f}"
+        cpu = "" if r["cpu"] is None else f"{r['cpu']:.3f}"
         drop = "" if r["rms_drop"] is None else f"{r['rms_drop']:.2f}x"
-        print(f"{r['result']:24s} {r['triangles']:9d} {r['rms']:8.4f} {drop:>6s} {r['volume_change_pct']:+8.3f}% "
-              f"{secs:>7s} {str(r['genus']):>6s} {str(r['closed_manifold']):>8s} {r['self_intersecting_pairs']:8d}")
-    if a.png:
+        if a.input:
+            drop = ""
+        print(f"{r['result']:24s} {r['triangles']:9d} {r['rms'] if not a.input else float('nan'):8.4f} {drop:>6s} "
+              f"{r['volume_change_pct']:+8.3f}% "
+              f"{secs:>7s} {cpu:>7s} {str(r['genus']):>6s} {str(r['closed_manifold']):>8s} {r['self_intersecting_pairs']:8d}")
+    if a.png and smoothing and not a.input:
         render([read_ply(os.path.join(a.out, p)) for p in ("sphere-midpoint.ply", "sphere-smoothed.ply",
                                                             "vtk-sinc.ply", "sphere-decimated.ply")],
                ["midpoint (terraced)", "surftrack smooth()", "VTK windowed sinc", "surftrack decimate()"], a.png,

@@ -198,22 +198,29 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   x.voxelBytesRead = x.mapped ? std::min<std::uintmax_t>(surface.voxelsRead * sizeOf(volume.type), x.voxelBytes)
                              : x.voxelBytes;
   for (const ComponentFigures& c : surface.components) x.extractedVolume += c.volume;
-  int next = stage + extractionStages(o) - 1 - (o.refine.smoothIterations > 0) - o.refine.decimate();
+  const int next = stage + extractionStages(o) - 1 - (o.refine.smoothIterations > 0) - o.refine.decimate();
+  surftrack::RefineOptions ro;
   if (o.refine.smoothIterations > 0) {
-    progress.stage(next++, stageCount, "smoothing");
     SmoothOptions so;
     so.iterations = o.refine.smoothIterations;
-    x.smooth = smooth(surface, so);
-    clock.lap(x.timings, "smooth");
+    ro.smooth = so;
   }
   if (o.refine.decimate()) {
-    progress.stage(next++, stageCount, "decimating");
     DecimateOptions d;
     d.maxError = o.refine.maxError;
     d.reduction = o.refine.reduction;
-    x.decimate = decimate(surface, d);
-    clock.lap(x.timings, "decimate");
+    ro.decimate = d;
   }
+  const char* running = nullptr;  // the step whose time the clock is measuring
+  ro.progress = [&](const ProgressEvent& e) {
+    if (running) clock.lap(x.timings, running);
+    running = e.stage == "smooth" ? "smooth" : "decimate";
+    progress.stage(next + e.index, stageCount, e.stage == "smooth" ? "smoothing" : "decimating");
+  };
+  const RefineReport refined = refineSurface(surface, ro);
+  if (running) clock.lap(x.timings, running);
+  x.smooth = refined.smooth;
+  x.decimate = refined.decimate;
 
   // The files need no half-edge operation: the triangles are checked to be a closed oriented
   // 2-manifold (what building the OpenMesh mesh would check) and written from the list.

@@ -2,10 +2,11 @@
 // it is performed (docs/theory.md, section 10). OpenMesh's own DecimaterT evaluates a candidate
 // when it enters the heap and collapses it later without asking the modules again, so a
 // constraint that depends on more than the candidate's one-ring (the embedding guard, the
-// Hausdorff bound after nearby collapses) may no longer hold. Here a candidate popped from the
-// heap whose vertex has changed since it was evaluated is dropped (it was pushed again, with its
-// new priority, when the vertex changed); one that has not is asked of every module and
-// collapsed only if all allow it.
+// Hausdorff bound after nearby collapses) may no longer hold. Here a candidate enters the heap
+// with its priority alone, again whenever that changes (a collapse into one of its vertices);
+// the latest entry of a candidate, when it comes out, is asked of OpenMesh's is_collapse_ok and
+// of every module, and collapsed only if all allow it. One that is refused waits until a
+// collapse changes the faces around its from-vertex, and then goes in again.
 #pragma once
 
 #include <cstddef>
@@ -24,7 +25,7 @@ class CheckedDecimaterT : public OpenMesh::Decimater::BaseDecimaterT<MeshT> {
   /// Collapses the best legal halfedges (lowest priority first) until at most `faces`
   /// triangles remain or no collapse is legal. A candidate enters the heap with
   /// `priority(ci)` (the priority module alone, cheap; ILLEGAL_COLLAPSE keeps it out) and is
-  /// asked of every module when it comes out. Returns the number of collapses.
+  /// asked of OpenMesh's is_collapse_ok and every module when it comes out. Returns the number of collapses.
   /// \pre initialize() succeeded; the mesh has vertex, halfedge, edge and face status.
   template <class Priority>
   std::size_t decimateToFaces(std::size_t faces, Priority&& priority);

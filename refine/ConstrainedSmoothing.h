@@ -22,9 +22,9 @@ struct SmoothingParameters {
 };
 
 struct SmoothingReport {
-  int passes = 0;                  ///< 2 * iterations
   std::size_t cubes = 0;           ///< digital 3-cubes holding triangles
   std::size_t unguardedCubes = 0;  ///< cubes not embedded in the input, left unchecked
+  std::size_t checkedCubes = 0;    ///< guarded cubes with a test left after the certificates
   std::size_t stepsBack = 0;       ///< vertex moves halved or undone by the fold check
   double maxDisplacement = 0;      ///< largest vertex move, physical units
 };

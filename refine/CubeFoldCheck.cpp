@@ -1,56 +1,31 @@
 #include "CubeFoldCheck.h"
 
 #include <algorithm>
-#include <cmath>
 
 #include "DigitalCube.h"
 
 namespace surftrack::refine {
 
-namespace {
-
-double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-/// Rotates `t` (cyclically, keeping its orientation) so that its vertex `id` comes first.
-Triangle3 startAt(const CubeTriangle& t, std::uint32_t id) {
-  int k = 0;
-  while (t.vertex[k] != id) ++k;
-  return {t.point[k], t.point[(k + 1) % 3], t.point[(k + 2) % 3]};
+bool triangleKeepsItsSide(const CubeTriangle& t, double tolerance) {
+  const Point3 n = triangleNormal(t.point);
+  if (!(norm(n) > tolerance)) return false;      // degenerate (section 8, point 3)
+  return dot(n, t.reference) > 0;                // not turned over
 }
 
-}  // namespace
+bool trianglesAreEmbedded(const CubeTriangle& t, const CubeTriangle& u, double tolerance) {
+  int shared[3], count = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      if (t.vertex[a] == u.vertex[b]) shared[count++] = a * 3 + b;
+  return !trianglesMeetOutsideShared(t.point, u.point, std::span<const int>(shared, std::size_t(count)), tolerance);
+}
 
 bool cubeIsEmbedded(std::span<const CubeTriangle> triangles, double tolerance) {
-  for (const CubeTriangle& t : triangles) {
-    const Point3 n = triangleNormal(t.point);
-    const double length = std::sqrt(dot(n, n));
-    if (!(length > tolerance)) return false;                  // degenerate (section 8, point 3)
-    if (!(dot(n, t.reference) > 0)) return false;             // turned over
-  }
+  for (const CubeTriangle& t : triangles)
+    if (!triangleKeepsItsSide(t, tolerance)) return false;
   for (std::size_t i = 0; i < triangles.size(); ++i)
-    for (std::size_t j = i + 1; j < triangles.size(); ++j) {
-      const CubeTriangle &t = triangles[i], &u = triangles[j];
-      std::uint32_t shared[3];
-      int count = 0;
-      for (std::uint32_t a : t.vertex)
-        if (std::find(u.vertex.begin(), u.vertex.end(), a) != u.vertex.end()) shared[count++] = a;
-      if (count == 3) return false;  // the same triangle twice
-      if (count == 0) {
-        if (trianglesMeetImproperly(t.point, u.point, 0, tolerance)) return false;
-      } else if (count == 1) {
-        if (trianglesMeetImproperly(startAt(t, shared[0]), startAt(u, shared[0]), 1, tolerance)) return false;
-      } else {
-        // Rotate t so that its unshared vertex comes last (the shared edge first); give u the
-        // same first two points and its own unshared vertex (u's orientation does not matter).
-        int k = 0;
-        while (t.vertex[k] == shared[0] || t.vertex[k] == shared[1]) ++k;
-        const Triangle3 a{t.point[(k + 1) % 3], t.point[(k + 2) % 3], t.point[k]};
-        Triangle3 b = a;
-        for (int m = 0; m < 3; ++m)
-          if (u.vertex[m] != shared[0] && u.vertex[m] != shared[1]) b[2] = u.point[m];
-        if (trianglesMeetImproperly(a, b, 2, tolerance)) return false;
-      }
-    }
+    for (std::size_t j = i + 1; j < triangles.size(); ++j)
+      if (!trianglesAreEmbedded(triangles[i], triangles[j], tolerance)) return false;
   return true;
 }
 

@@ -26,7 +26,16 @@ struct CubeTriangle {
 /// Absolute tolerance of the fold check, in voxels (index space).
 inline constexpr double kFoldTolerance = 1e-9;
 
-/// True when the triangles of one cube are embedded (see above) up to `tolerance`.
+/// True when triangle t is non-degenerate and keeps the side of its reference normal.
+bool triangleKeepsItsSide(const CubeTriangle& t, double tolerance = kFoldTolerance);
+
+/// True when triangles t and u of one cube meet only in the vertices they share (by id) and the
+/// edge those span, up to `tolerance`.
+/// \pre neither is degenerate (triangleKeepsItsSide).
+bool trianglesAreEmbedded(const CubeTriangle& t, const CubeTriangle& u, double tolerance = kFoldTolerance);
+
+/// True when the triangles of one cube are embedded (see above) up to `tolerance`: each keeps
+/// its side, and every two are embedded.
 bool cubeIsEmbedded(std::span<const CubeTriangle> triangles, double tolerance = kFoldTolerance);
 
 /// The digital 3-cube (its minimum corner m, paper §2.1.2) whose edges carry the grid edges

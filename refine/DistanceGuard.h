@@ -12,11 +12,12 @@
 
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 #include <OpenMesh/Tools/Decimater/ModBaseT.hh>
 
-#include "TriangleGrid.h"
+#include "MeshTriangles.h"
 #include "TriangleIntersection.h"
 
 namespace surftrack::refine {
@@ -26,6 +27,7 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
  public:
   DECIMATING_MODULE(ModSampledDistanceT, MeshT, SampledDistance);
   using FaceHandle = typename MeshT::FaceHandle;
+  using VertexHandle = typename MeshT::VertexHandle;
 
   explicit ModSampledDistanceT(MeshT& mesh) : Base(mesh, true) {}
   ~ModSampledDistanceT() override {
@@ -41,60 +43,78 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     MeshT& m = Base::mesh();
     if (!samplesOf_.is_valid()) m.add_property(samplesOf_);
     original_.clear();
+    originalBox_.clear();
     lastHit_ = 0;
-    samples_.clear();
     // Cells about twice the larger of the tolerance and the mean edge length: a triangle
     // meets a few cells, a query a few more.
-    double edges = 0;
-    for (auto e : m.edges()) edges += m.calc_edge_length(e);
-    const double cell = 2 * std::max(tolerance_, m.n_edges() ? edges / double(m.n_edges()) : 1.0);
-    originalGrid_.clear(cell);
-    currentGrid_.clear(cell);
+    originalGrid_.reset(LiveTriangleGrid<MeshT>::boundsOf(m), 2 * std::max(tolerance_, meanEdgeLength(m)));
+    currentGrid_.build(m, tolerance_);
     for (auto f : m.faces()) {
-      const Triangle3 t = triangleOf(f);
-      originalGrid_.insert(std::uint32_t(original_.size()), t);
-      currentGrid_.insert(std::uint32_t(f.idx()), t);
+      const Triangle3 t = triangleOf(m, f);
+      originalGrid_.insert(std::uint32_t(original_.size()), 0, boxOf(t));
       original_.push_back(t);
+      originalBox_.push_back(boxOf(t));
       auto& list = m.property(samplesOf_, f);
       list.clear();
-      addSample(list, {(t[0][0] + t[1][0] + t[2][0]) / 3, (t[0][1] + t[1][1] + t[2][1]) / 3,
-                       (t[0][2] + t[1][2] + t[2][2]) / 3});
+      list.push_back({(t[0][0] + t[1][0] + t[2][0]) / 3, (t[0][1] + t[1][1] + t[2][1]) / 3,
+                      (t[0][2] + t[1][2] + t[2][2]) / 3});
     }
     for (auto e : m.edges()) {
       const auto h = m.halfedge_handle(e, 0);
       const auto a = m.point(m.from_vertex_handle(h)), b = m.point(m.to_vertex_handle(h));
-      addSample(m.property(samplesOf_, m.face_handle(h)), {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2});
+      m.property(samplesOf_, m.face_handle(h)).push_back({(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2});
     }
     for (auto v : m.vertices()) {
       const auto p = m.point(v);
-      addSample(m.property(samplesOf_, *m.vf_range(v).begin()), {p[0], p[1], p[2]});
+      m.property(samplesOf_, *m.vf_range(v).begin()).push_back(pointOf(p));
     }
   }
 
   float collapse_priority(const CollapseInfo& ci) override {
     MeshT& m = Base::mesh();
+    evaluated_ = ci.v0v1;
     created_.clear();
-    for (auto f : m.vf_range(ci.v0)) {
-      if (f == ci.fl || f == ci.fr) continue;
-      Triangle3 t;
-      int k = 0;
-      for (auto v : m.fv_range(f)) t[k++] = v == ci.v0 ? pointOf(ci.p1) : pointOf(m.point(v));
+    createdFace_.clear();
+    forEachCreatedTriangle(m, ci, [&](FaceHandle f, const auto&, const Triangle3& t) {
       created_.push_back(t);
-    }
+      createdFace_.push_back(f);
+    });
     const double e2 = tolerance_ * tolerance_;
-    // Decimated -> original.
-    for (const Triangle3& t : created_)
+    // Decimated -> original. The distance to a triangle is a convex function, so when the
+    // three corners of a created triangle are within the tolerance of one original triangle,
+    // so is every point of it (its samples need no test).
+    for (const Triangle3& t : created_) {
+      std::uint32_t hit = 0;
+      if (!nearOriginal(t[0], e2, &hit)) return float(Base::ILLEGAL_COLLAPSE);
+      if (squaredDistanceToTriangle(t[1], original_[hit]) <= e2 &&
+          squaredDistanceToTriangle(t[2], original_[hit]) <= e2)
+        continue;
       for (int i = 0; i <= kSteps; ++i)
         for (int j = 0; i + j <= kSteps; ++j) {
           const double a = double(i) / kSteps, b = double(j) / kSteps, c = 1 - a - b;
           const Point3 p{a * t[0][0] + b * t[1][0] + c * t[2][0], a * t[0][1] + b * t[1][1] + c * t[2][1],
                          a * t[0][2] + b * t[1][2] + c * t[2][2]};
-          if (!nearOriginal(p, e2)) return float(Base::ILLEGAL_COLLAPSE);
+          if (!nearOriginal(p, e2, nullptr)) return float(Base::ILLEGAL_COLLAPSE);
         }
-    // Original -> decimated.
-    for (auto f : m.vf_range(ci.v0))
-      for (std::uint32_t s : m.property(samplesOf_, f))
-        if (!nearCurrent(samples_[s], e2, ci.v0, nullptr)) return float(Base::ILLEGAL_COLLAPSE);
+    }
+    // Original -> decimated: a sample of a face that the collapse keeps (with v1 for v0) is
+    // most often still near that face, so it is tried first; the face each sample is found
+    // near is kept for postprocess_collapse.
+    assigned_.clear();
+    for (auto f : m.vf_range(ci.v0)) {
+      std::size_t own = created_.size();
+      for (std::size_t i = 0; i < createdFace_.size(); ++i)
+        if (createdFace_[i] == f) own = i;
+      for (const Point3& p : m.property(samplesOf_, f)) {
+        FaceHandle found;
+        if (own < created_.size() && squaredDistanceToTriangle(p, created_[own]) <= e2) found = f;
+        for (std::size_t i = 0; i < created_.size() && !found.is_valid(); ++i)
+          if (squaredDistanceToTriangle(p, created_[i]) <= e2) found = createdFace_[i];
+        if (!found.is_valid()) found = nearCurrent(p, e2, ci.v0);
+        if (!found.is_valid()) return float(Base::ILLEGAL_COLLAPSE);
+        assigned_.push_back(found);
+      }
+    }
     return float(Base::LEGAL_COLLAPSE);
   }
 
@@ -106,92 +126,68 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
       pending_.insert(pending_.end(), list.begin(), list.end());
       list.clear();
     }
+    // The collapse is the one just evaluated (CheckedDecimater.h asks every module right
+    // before it collapses), so the faces found there take the samples.
+    if (evaluated_ != ci.v0v1 || assigned_.size() != pending_.size())
+      throw std::logic_error("ModSampledDistanceT: a collapse that was not just evaluated");
   }
 
   void postprocess_collapse(const CollapseInfo& ci) override {
     MeshT& m = Base::mesh();
-    created_.clear();
-    for (auto f : m.vf_range(ci.v1)) currentGrid_.insert(std::uint32_t(f.idx()), triangleOf(f));
-    const double e2 = tolerance_ * tolerance_;
-    for (std::uint32_t s : pending_) {
-      // The nearest of v1's triangles if one is within the tolerance, else the nearest nearby.
-      FaceHandle best;
-      double bestD = e2;
-      for (auto f : m.vf_range(ci.v1)) {
-        const double d = squaredDistanceToTriangle(samples_[s], triangleOf(f));
-        if (d <= bestD) {
-          bestD = d;
-          best = f;
-        }
-      }
-      if (!best.is_valid()) nearCurrent(samples_[s], e2, typename MeshT::VertexHandle(), &best);
-      if (!best.is_valid()) best = *m.vf_range(ci.v1).begin();  // (the check found one; rounding)
-      m.property(samplesOf_, best).push_back(s);
-    }
+    for (std::size_t k = 0; k < pending_.size(); ++k) m.property(samplesOf_, assigned_[k]).push_back(pending_[k]);
+    currentGrid_.collapsed(m, ci.v1, ci.fl, ci.fr);
+    evaluated_ = typename MeshT::HalfedgeHandle();
   }
 
  private:
-  template <class P>
-  static Point3 pointOf(const P& p) { return {double(p[0]), double(p[1]), double(p[2])}; }
-  Triangle3 triangleOf(FaceHandle f) {
-    Triangle3 t;
-    int k = 0;
-    for (auto v : Base::mesh().fv_range(f)) t[k++] = pointOf(Base::mesh().point(v));
-    return t;
-  }
-  void addSample(std::vector<std::uint32_t>& list, const Point3& p) {
-    list.push_back(std::uint32_t(samples_.size()));
-    samples_.push_back(p);
-  }
-  bool nearOriginal(const Point3& p, double e2) {
+  /// p is within the tolerance of an original triangle (its index into *hit if asked).
+  bool nearOriginal(const Point3& p, double e2, std::uint32_t* hit) {
     // Neighbouring samples are most often near the same original triangle: try it first.
-    if (squaredDistanceToTriangle(p, original_[lastHit_]) <= e2) return true;
+    if (squaredDistanceToTriangle(p, original_[lastHit_]) <= e2) {
+      if (hit) *hit = lastHit_;
+      return true;
+    }
     bool found = false;
-    originalGrid_.near({p, p, p}, tolerance_, [&](std::uint32_t id) {
-      if (!found && squaredDistanceToTriangle(p, original_[id]) <= e2) {
+    const Box3 query = boxOf({p, p, p}, tolerance_);
+    originalGrid_.near(query, [&](std::uint32_t id, std::uint32_t) {
+      // Only a triangle whose box meets the query box can be within the tolerance.
+      if (!found && originalBox_[id].meets(query) && squaredDistanceToTriangle(p, original_[id]) <= e2) {
         found = true;
         lastHit_ = id;
       }
     });
+    if (found && hit) *hit = lastHit_;
     return found;
   }
-  /// A current triangle within the tolerance of p: one of created_, or one without `skip`
-  /// (the collapsing vertex); the nearest one into *best if asked.
-  bool nearCurrent(const Point3& p, double e2, typename MeshT::VertexHandle skip, FaceHandle* best) {
-    for (const Triangle3& t : created_)
-      if (squaredDistanceToTriangle(p, t) <= e2) return true;
+  /// A current triangle within the tolerance of p that does not have `skip` (the collapsing
+  /// vertex), or an invalid handle.
+  FaceHandle nearCurrent(const Point3& p, double e2, VertexHandle skip) {
     MeshT& m = Base::mesh();
-    double bestD = e2;
-    bool found = false;
-    currentGrid_.near({p, p, p}, tolerance_, [&](std::uint32_t id) {
-      if (found && !best) return;
-      const FaceHandle f{int(id)};
-      if (m.status(f).deleted()) return;
+    FaceHandle found;
+    currentGrid_.near(boxOf({p, p, p}, tolerance_), [&](FaceHandle f) {
+      if (found.is_valid()) return;
       Triangle3 t;
-      int k = 0;
-      bool hasSkip = false;
-      for (auto v : m.fv_range(f)) {
-        hasSkip = hasSkip || v == skip;
-        t[k++] = pointOf(m.point(v));
+      auto h = m.halfedge_handle(f);
+      for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) {
+        const VertexHandle v = m.to_vertex_handle(h);
+        if (v == skip) return;
+        t[k] = pointOf(m.point(v));
       }
-      if (hasSkip) return;
-      const double d = squaredDistanceToTriangle(p, t);
-      if (d <= bestD) {
-        found = true;
-        bestD = d;
-        if (best) *best = f;
-      }
+      if (squaredDistanceToTriangle(p, t) <= e2) found = f;
     });
     return found;
   }
 
   double tolerance_ = 1;
   std::vector<Triangle3> original_, created_;
-  std::vector<Point3> samples_;
-  std::vector<std::uint32_t> pending_;
+  std::vector<Box3> originalBox_;
+  std::vector<FaceHandle> createdFace_, assigned_;
+  std::vector<Point3> pending_;
   std::uint32_t lastHit_ = 0;
-  TriangleGrid originalGrid_, currentGrid_;
-  OpenMesh::FPropHandleT<std::vector<std::uint32_t>> samplesOf_;
+  typename MeshT::HalfedgeHandle evaluated_;
+  TriangleGrid originalGrid_;
+  LiveTriangleGrid<MeshT> currentGrid_;
+  OpenMesh::FPropHandleT<std::vector<Point3>> samplesOf_;  // each face's samples, in place
 };
 
 }  // namespace surftrack::refine

@@ -11,11 +11,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <OpenMesh/Tools/Decimater/ModBaseT.hh>
 
-#include "TriangleGrid.h"
+#include "MeshTriangles.h"
 #include "TriangleIntersection.h"
 
 namespace surftrack::refine {
@@ -30,53 +31,35 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
   explicit ModEmbeddingGuardT(MeshT& mesh) : Base(mesh, true) {}
 
   void initialize() override {
-    MeshT& m = Base::mesh();
-    double total = 0;
-    std::size_t count = 0;
-    for (auto e : m.edges()) {
-      total += m.calc_edge_length(e);
-      ++count;
-    }
-    cell_ = count ? 2 * total / double(count) : 1.0;
-    tolerance_ = 1e-9 * cell_;
-    grid_.clear(cell_);
-    for (auto f : m.faces()) enter(f);
+    const MeshT& m = Base::mesh();
+    tolerance_ = 1e-9 * 2 * meanEdgeLength(m);
+    grid_.build(m, 0);
   }
 
   float collapse_priority(const CollapseInfo& ci) override {
     MeshT& m = Base::mesh();
     // The triangles the collapse creates: v0's faces but the two on the collapsing edge.
     created_.clear();
-    for (auto f : m.vf_range(ci.v0)) {
-      if (f == ci.fl || f == ci.fr) continue;
-      Face t;
-      int k = 0;
-      for (auto v : m.fv_range(f)) {
-        t.id[k] = v == ci.v0 ? ci.v1 : v;
-        t.p[k] = pointOf(v == ci.v0 ? ci.p1 : m.point(v));
-        ++k;
-      }
-      created_.push_back(t);
-    }
+    forEachCreatedTriangle(m, ci, [&](FaceHandle, const std::array<VertexHandle, 3>& ids, const Triangle3& p) {
+      created_.push_back({ids, p, boxOf(p, tolerance_)});
+    });
     for (std::size_t i = 0; i < created_.size(); ++i) {
       for (std::size_t j = i + 1; j < created_.size(); ++j)
-        if (meet(created_[i], created_[j])) return float(Base::ILLEGAL_COLLAPSE);
-      // Old triangles near it, but those of v0 (removed or replaced).
+        if (created_[i].box.meets(created_[j].box) && meet(created_[i], created_[j])) return float(Base::ILLEGAL_COLLAPSE);
+      // Old triangles near it, but those of v0 (removed or replaced): only one whose box meets
+      // the created one's (enlarged by the tolerance) can meet it.
       ++stamp_;
       bool illegal = false;
-      grid_.near(created_[i].p, tolerance_, [&](std::uint32_t id) {
-        const FaceHandle f{int(id)};
-        if (illegal || m.status(f).deleted() || seen(f)) return;
+      grid_.near(created_[i].box, [&](FaceHandle f) {
+        if (illegal || seen(f)) return;
         Face u;
-        int k = 0;
-        bool ofV0 = false;
-        for (auto v : m.fv_range(f)) {
-          ofV0 = ofV0 || v == ci.v0;
-          u.id[k] = v;
-          u.p[k] = pointOf(m.point(v));
-          ++k;
+        auto h = m.halfedge_handle(f);
+        for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) {
+          u.id[k] = m.to_vertex_handle(h);
+          if (u.id[k] == ci.v0) return;
+          u.p[k] = pointOf(m.point(u.id[k]));
         }
-        illegal = !ofV0 && meet(created_[i], u);
+        illegal = meet(created_[i], u);
       });
       if (illegal) return float(Base::ILLEGAL_COLLAPSE);
     }
@@ -84,17 +67,15 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
   }
 
   void postprocess_collapse(const CollapseInfo& ci) override {
-    for (auto f : Base::mesh().vf_range(ci.v1)) enter(f);
+    grid_.collapsed(Base::mesh(), ci.v1, ci.fl, ci.fr);
   }
 
  private:
   struct Face {
     std::array<VertexHandle, 3> id;
     Triangle3 p;
+    Box3 box;
   };
-
-  template <class P>
-  static Point3 pointOf(const P& p) { return {double(p[0]), double(p[1]), double(p[2])}; }
 
   /// t and u meet other than in what they share (their common vertex handles).
   bool meet(const Face& t, const Face& u) const {
@@ -103,26 +84,9 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
       for (int b = 0; b < 3; ++b)
         if (t.id[a] == u.id[b]) shared[count++] = a * 3 + b;
     if (count == 3) return true;
-    if (count == 0) return trianglesMeetImproperly(t.p, u.p, 0, tolerance_);
-    if (count == 1) {
-      const int a = shared[0] / 3, b = shared[0] % 3;
-      return trianglesMeetImproperly({t.p[a], t.p[(a + 1) % 3], t.p[(a + 2) % 3]},
-                                     {u.p[b], u.p[(b + 1) % 3], u.p[(b + 2) % 3]}, 1, tolerance_);
-    }
-    // Two shared: rotate t so that its unshared vertex is last, give u the same first two.
-    const int ta = shared[0] / 3, tb = shared[1] / 3, ua = shared[0] % 3, ub = shared[1] % 3;
-    const int tc = 3 - ta - tb, uc = 3 - ua - ub;
-    const Triangle3 a{t.p[(tc + 1) % 3], t.p[(tc + 2) % 3], t.p[tc]};
-    return trianglesMeetImproperly(a, {a[0], a[1], u.p[uc]}, 2, tolerance_);
+    return trianglesMeetOutsideShared(t.p, u.p, std::span<const int>(shared, std::size_t(count)), tolerance_);
   }
 
-  void enter(FaceHandle f) {
-    MeshT& m = Base::mesh();
-    Triangle3 p;
-    int k = 0;
-    for (auto v : m.fv_range(f)) p[k++] = pointOf(m.point(v));
-    grid_.insert(std::uint32_t(f.idx()), p);
-  }
   /// Marks f as tested for the current created triangle; true if it already was.
   bool seen(FaceHandle f) {
     if (std::size_t(f.idx()) >= mark_.size()) mark_.resize(Base::mesh().n_faces(), 0);
@@ -131,8 +95,8 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     return false;
   }
 
-  double cell_ = 1, tolerance_ = 1e-9;
-  TriangleGrid grid_;
+  double tolerance_ = 1e-9;
+  LiveTriangleGrid<MeshT> grid_;
   std::vector<Face> created_;
   std::vector<std::uint64_t> mark_;
   std::uint64_t stamp_ = 0;

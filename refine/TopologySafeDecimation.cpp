@@ -28,7 +28,6 @@ DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p
 
   DecimationReport report;
   report.trianglesBefore = mesh.n_faces();
-  report.verticesBefore = mesh.n_vertices();
   mesh.request_vertex_status();
   mesh.request_edge_status();
   mesh.request_halfedge_status();
@@ -60,7 +59,6 @@ DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p
   decimater.decimateToFaces(report.targetTriangles, [&](const auto& ci) { return quadricModule.collapse_priority(ci); });
   mesh.garbage_collection();
   report.trianglesAfter = mesh.n_faces();
-  report.verticesAfter = mesh.n_vertices();
   return report;
 }
 

@@ -28,7 +28,6 @@ struct DecimationParameters {
 
 struct DecimationReport {
   std::size_t trianglesBefore = 0, trianglesAfter = 0;
-  std::size_t verticesBefore = 0, verticesAfter = 0;
   std::size_t targetTriangles = 0;  ///< what targetReduction asked for (0: no target)
 };
 

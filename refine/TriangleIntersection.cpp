@@ -6,21 +6,16 @@ namespace surftrack::refine {
 
 namespace {
 
-Point3 sub(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Point3 cross(const Point3& a, const Point3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm(const Point3& a) { return std::sqrt(dot(a, a)); }
-
 using Point2 = std::array<double, 2>;
 
 /// Twice the signed area of (a, b, c), divided by |b - a|: the signed distance of c to line ab.
 double sideOf(const Point2& a, const Point2& b, const Point2& c) {
   const double ux = b[0] - a[0], uy = b[1] - a[1];
-  const double len = std::hypot(ux, uy);
+  const double len = std::sqrt(ux * ux + uy * uy);  // (no overflow here: std::hypot is slow)
   const double area = ux * (c[1] - a[1]) - uy * (c[0] - a[0]);
-  return len > 0 ? area / len : std::hypot(c[0] - a[0], c[1] - a[1]);
+  if (len > 0) return area / len;
+  const double vx = c[0] - a[0], vy = c[1] - a[1];
+  return std::sqrt(vx * vx + vy * vy);
 }
 
 /// Segments [a, b] and [c, d] of a plane meet or come within about `tol`.
@@ -38,6 +33,24 @@ bool pointInTriangle2(const Point2& p, const std::array<Point2, 3>& t, double to
   const double sign = s >= 0 ? 1.0 : -1.0;
   for (int i = 0; i < 3; ++i)
     if (sign * sideOf(t[i], t[(i + 1) % 3], p) < -tol) return false;
+  return true;
+}
+
+/// Every point of `points` lies farther than `tol` from t's plane, all on the same side: then
+/// the convex hull of those points (and of any point of the plane) meets t's plane at most in
+/// that point.
+template <std::size_t N>
+bool strictlyOnOneSide(const Triangle3& t, const std::array<Point3, N>& points, double tol) {
+  const Point3 n = triangleNormal(t);
+  const double len = norm(n);
+  if (!(len > 0)) return false;
+  int side = 0;
+  for (const Point3& q : points) {
+    const double d = dot(n, sub(q, t[0])) / len;
+    const int s = d > tol ? 1 : d < -tol ? -1 : 0;
+    if (s == 0 || (side != 0 && s != side)) return false;
+    side = s;
+  }
   return true;
 }
 
@@ -71,8 +84,6 @@ double squaredDistanceToTriangle(const Point3& p, const Triangle3& t) {
   const double denom = 1 / (va + vb + vc);
   return at(vb * denom, vc * denom);
 }
-
-Point3 triangleNormal(const Triangle3& t) { return cross(sub(t[1], t[0]), sub(t[2], t[0])); }
 
 bool segmentMeetsTriangle(const Point3& a, const Point3& b, const Triangle3& t, double tol) {
   const Point3 n = triangleNormal(t);
@@ -122,14 +133,38 @@ bool trianglesMeetImproperly(const Triangle3& t, const Triangle3& u, int shared,
     return dot(cross(e, sub(u[2], t[0])), ut) / norm(e) > -tol;
   }
   if (shared == 1) {
-    // Sharing vertex p = t0 = u0: they meet elsewhere iff an opposite edge meets the other
-    // triangle (docs/theory.md, section 8).
+    // Sharing vertex p = t0 = u0: when t1 and t2 lie strictly on one side of u's plane (or u1,
+    // u2 of t's), the triangles meet in p alone. Otherwise they meet elsewhere iff an opposite
+    // edge meets the other triangle (docs/theory.md, section 8).
+    if (strictlyOnOneSide(u, std::array<Point3, 2>{t[1], t[2]}, tol) ||
+        strictlyOnOneSide(t, std::array<Point3, 2>{u[1], u[2]}, tol))
+      return false;
     return segmentMeetsTriangle(t[1], t[2], u, tol) || segmentMeetsTriangle(u[1], u[2], t, tol);
   }
+  // Sharing nothing: apart when one lies strictly on one side of the other's plane; otherwise
+  // they meet iff an edge of one meets the other.
+  if (strictlyOnOneSide(t, u, tol) || strictlyOnOneSide(u, t, tol)) return false;
   for (int k = 0; k < 3; ++k)
     if (segmentMeetsTriangle(t[k], t[(k + 1) % 3], u, tol) || segmentMeetsTriangle(u[k], u[(k + 1) % 3], t, tol))
       return true;
   return false;
+}
+
+bool trianglesMeetOutsideShared(const Triangle3& t, const Triangle3& u, std::span<const int> shared, double tol) {
+  if (shared.size() >= 3) return true;
+  if (shared.empty()) return trianglesMeetImproperly(t, u, 0, tol);
+  if (shared.size() == 1) {
+    const int a = shared[0] / 3, b = shared[0] % 3;
+    return trianglesMeetImproperly({t[a], t[(a + 1) % 3], t[(a + 2) % 3]}, {u[b], u[(b + 1) % 3], u[(b + 2) % 3]}, 1,
+                                   tol);
+  }
+  // Two shared: rotate t so that its unshared vertex comes last (the shared edge first), and
+  // give u the same first two points and its own unshared vertex (u's orientation does not
+  // matter).
+  const int ta = shared[0] / 3, tb = shared[1] / 3, ua = shared[0] % 3, ub = shared[1] % 3;
+  const int tc = 3 - ta - tb, uc = 3 - ua - ub;
+  const Triangle3 a{t[(tc + 1) % 3], t[(tc + 2) % 3], t[tc]};
+  return trianglesMeetImproperly(a, {a[0], a[1], u[uc]}, 2, tol);
 }
 
 }  // namespace surftrack::refine

@@ -6,6 +6,8 @@
 #pragma once
 
 #include <array>
+#include <cmath>
+#include <span>
 
 namespace surftrack::refine {
 
@@ -25,11 +27,25 @@ bool segmentMeetsTriangle(const Point3& a, const Point3& b, const Triangle3& t, 
 /// \pre neither triangle is degenerate.
 bool trianglesMeetImproperly(const Triangle3& t, const Triangle3& u, int shared, double tolerance);
 
+/// True when triangles t and u meet anywhere other than in the vertices they share and the
+/// edge those span (or come within about `tolerance` of doing so). `shared` lists the shared
+/// vertices, 0 to 2 of them, as a * 3 + b for t[a] = u[b]; three shared vertices are the same
+/// triangle twice, which counts as meeting.
+bool trianglesMeetOutsideShared(const Triangle3& t, const Triangle3& u, std::span<const int> shared,
+                                double tolerance);
+
 /// The squared distance from p to the closed triangle t (the closest point by Voronoi regions,
 /// after Ericson, "Real-Time Collision Detection", 5.1.5).
 double squaredDistanceToTriangle(const Point3& p, const Triangle3& t);
 
+inline Point3 sub(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline Point3 cross(const Point3& a, const Point3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+inline double norm(const Point3& a) { return std::sqrt(dot(a, a)); }
+
 /// (b - a) x (c - a): twice the area, along the right-hand-rule normal.
-Point3 triangleNormal(const Triangle3& t);
+inline Point3 triangleNormal(const Triangle3& t) { return cross(sub(t[1], t[0]), sub(t[2], t[0])); }
 
 }  // namespace surftrack::refine

@@ -13,6 +13,7 @@
 #include <numbers>
 #include <vector>
 
+#include "ClosedManifold.h"
 #include "DigitalCube.h"
 #include "TriangleMesh.h"
 #include "VoxelComponents.h"
@@ -41,54 +42,14 @@ inline ::testing::AssertionResult isClosedManifoldOn(const TriangleMesh& mesh,
   if (keys != boundaryKeys)
     return ::testing::AssertionFailure() << "vertex set (" << V << ") differs from the boundary ("
                                          << boundaryKeys.size() << " surfels)";
-  std::vector<std::array<std::uint32_t, 3>> sortedTriangles;
-  std::vector<std::uint64_t> directed;  // (a << 32) | b for every triangle edge a -> b
-  std::vector<std::array<std::uint32_t, 3>> corners;  // (v, a, b) for every triangle (v, a, b)
-  for (const auto& t : mesh.triangles) {
-    for (std::uint32_t v : t)
-      if (v >= V) return ::testing::AssertionFailure() << "vertex index out of range";
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-      return ::testing::AssertionFailure() << "degenerate triangle " << t[0] << "," << t[1] << "," << t[2];
-    std::array<std::uint32_t, 3> sorted = t;
-    std::sort(sorted.begin(), sorted.end());
-    sortedTriangles.push_back(sorted);
-    for (int j = 0; j < 3; ++j) {
-      directed.push_back((std::uint64_t(t[j]) << 32) | t[(j + 1) % 3]);
-      corners.push_back({t[j], t[(j + 1) % 3], t[(j + 2) % 3]});
-    }
-  }
-  std::sort(sortedTriangles.begin(), sortedTriangles.end());
-  if (std::adjacent_find(sortedTriangles.begin(), sortedTriangles.end()) != sortedTriangles.end())
-    return ::testing::AssertionFailure() << "repeated triangle";
-  std::sort(directed.begin(), directed.end());
-  if (auto it = std::adjacent_find(directed.begin(), directed.end()); it != directed.end())
-    return ::testing::AssertionFailure() << "directed edge " << (*it >> 32) << "->"
-                                         << (*it & 0xFFFFFFFFu) << " used twice";
-  for (std::uint64_t key : directed)
-    if (!std::binary_search(directed.begin(), directed.end(), (key << 32) | (key >> 32)))
-      return ::testing::AssertionFailure() << "edge " << (key >> 32) << "->" << (key & 0xFFFFFFFFu)
-                                           << " has one triangle only (or a misoriented one)";
-  // Star of v: its corners (v, a, b) sorted by a; a -> b must be one cycle through all of them.
-  std::sort(corners.begin(), corners.end());
-  std::size_t begin = 0;
-  for (std::uint32_t v = 0; v < V; ++v) {
-    std::size_t end = begin;
-    while (end < corners.size() && corners[end][0] == v) ++end;
-    if (end == begin) return ::testing::AssertionFailure() << "vertex " << v << " is unused";
-    const auto first = corners.begin() + begin, last = corners.begin() + end;
-    std::uint32_t a = (*first)[1];
-    std::size_t steps = 0;
-    do {
-      const auto it = std::lower_bound(first, last, std::array<std::uint32_t, 3>{v, a, 0});
-      if (it == last || (*it)[1] != a) return ::testing::AssertionFailure() << "star of " << v << " is open";
-      a = (*it)[2];
-    } while (++steps <= end - begin && a != (*first)[1]);
-    if (steps != end - begin)
-      return ::testing::AssertionFailure() << "star of vertex " << v << " (" << mesh.surfels[v]
-                                           << ") is not one disc";
-    begin = end;
-  }
-  if (euler) *euler = long(V) - long(directed.size() / 2) + long(mesh.triangles.size());
+  const checks::Topology topology = checks::topologyOf(V, mesh.triangles);
+  if (!topology.manifoldVertices) return ::testing::AssertionFailure() << topology.problem;
+  std::vector<char> used(V, 0);
+  for (const auto& t : mesh.triangles)
+    for (std::uint32_t v : t) used[v] = 1;
+  for (std::uint32_t v = 0; v < V; ++v)
+    if (!used[v]) return ::testing::AssertionFailure() << "vertex " << v << " (" << mesh.surfels[v] << ") is unused";
+  if (euler) *euler = long(topology.euler);
   return ::testing::AssertionSuccess();
 }
 

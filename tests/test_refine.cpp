@@ -12,10 +12,15 @@
 #include <cmath>
 #include <optional>
 #include <random>
+#include <set>
+#include <string>
 #include <vector>
 
-#include "Image.h"
 #include "CgalMeshChecks.h"
+#include "ConfigurationTable.h"
+#include "DigitalCube.h"
+#include "FoldCertificate.h"
+#include "Image.h"
 #include "PairTestName.h"
 #include "Phantoms.h"
 
@@ -339,3 +344,109 @@ TEST(RefineVolumes, AtlasLabel) {
       volume);
 }
 #endif
+
+// The fold certificates (refine/FoldCertificate.h, docs/theory.md section 8) against CGAL:
+// every triangle and pair of triangles of a configuration-table entry (the four pairs, all 256
+// configurations) that has a certificate is checked at every corner of its box of parameters
+// and at random points of it (fixed seed): a certified triangle keeps the side of its
+// reference normal (CGAL's exact orientation), a certified pair does not self-intersect as a
+// two-triangle mesh (CGAL's self_intersections, which accepts what the two share).
+TEST(FoldCertificates, HoldAtEveryPositionInTheirBoxes) {
+  const double epsilon = SmoothOptions{}.epsilon;
+  refine::FoldCertificates certificates(epsilon);
+  using Edges = refine::CubeEdges;
+  auto at = [](int k, double tau) {
+    const Voxel low = cube::cornerOffset(cube::edgeLowCorner(k));
+    std::array<double, 3> p{double(low.x), double(low.y), double(low.z)};
+    p[cube::edgeAxis(k)] += tau;
+    return ck::Kernel::Point_3(p[0], p[1], p[2]);
+  };
+  std::set<Edges> triangles;
+  std::set<std::pair<Edges, Edges>> pairs;
+  for (AdjacencyPair pair : {AdjacencyPair::k26_6, AdjacencyPair::k18_6, AdjacencyPair::k6_18, AdjacencyPair::k6_26})
+    for (const CubeTriangulation& entry : configurationTables(pair)) {
+      const auto all = entry.allTriangles();
+      for (std::size_t i = 0; i < all.size(); ++i) {
+        triangles.insert(all[i]);
+        for (std::size_t j = i + 1; j < all.size(); ++j) pairs.insert({all[i], all[j]});
+      }
+    }
+  std::mt19937_64 rng(20261202);
+  std::uniform_real_distribution<double> tau(epsilon, 1 - epsilon);
+  auto position = [&](int sample, int slot) {  // the corners first, then random points
+    return sample < 64 ? (sample >> slot & 1 ? 1 - epsilon : epsilon) : tau(rng);
+  };
+  std::size_t certain = 0, uncertain = 0;
+  for (const Edges& t : triangles) {
+    if (!certificates.triangleIsCertain(t)) {
+      ++uncertain;
+      continue;
+    }
+    ++certain;
+    const auto m0 = at(t[0], 0.5), m1 = at(t[1], 0.5), m2 = at(t[2], 0.5);
+    const auto reference = CGAL::cross_product(m1 - m0, m2 - m0);
+    for (int sample = 0; sample < 8 + 32; ++sample) {
+      const int s = sample < 8 ? sample : 64 + sample;
+      const auto a = at(t[0], position(s, 0)), b = at(t[1], position(s, 1)), c = at(t[2], position(s, 2));
+      ASSERT_EQ(CGAL::orientation(a, b, c, a + reference), CGAL::POSITIVE)
+          << "triangle " << int(t[0]) << "," << int(t[1]) << "," << int(t[2]);
+    }
+  }
+  EXPECT_GT(certain, 0u);
+  for (const auto& [t, u] : pairs) {
+    if (!certificates.pairIsCertain(t, u)) {
+      ++uncertain;
+      continue;
+    }
+    ++certain;
+    // The distinct edges of the pair, each a vertex of the two-triangle mesh.
+    std::vector<std::uint8_t> edges;
+    for (const Edges* x : {&t, &u})
+      for (std::uint8_t e : *x)
+        if (std::find(edges.begin(), edges.end(), e) == edges.end()) edges.push_back(e);
+    auto index = [&](std::uint8_t e) { return std::uint32_t(std::find(edges.begin(), edges.end(), e) - edges.begin()); };
+    const ck::Triangles faces{{index(t[0]), index(t[1]), index(t[2])}, {index(u[0]), index(u[1]), index(u[2])}};
+    for (int sample = 0; sample < 64 + 16; ++sample) {
+      if (sample < 64 && sample >= (1 << edges.size())) continue;
+      ck::Points points;
+      for (std::size_t k = 0; k < edges.size(); ++k) {
+        const auto p = at(edges[k], position(sample, int(k)));
+        points.push_back({p.x(), p.y(), p.z()});
+      }
+      ASSERT_EQ(ck::selfIntersections(ck::cgalMesh(points, faces)), 0u)
+          << "pair " << int(t[0]) << "," << int(t[1]) << "," << int(t[2]) << " / " << int(u[0]) << "," << int(u[1])
+          << "," << int(u[2]) << " at sample " << sample;
+    }
+  }
+  // Not everything is certain: some pairs of the tables can fold, and are left to the check.
+  EXPECT_GT(uncertain, 0u);
+}
+
+// refineSurface: smooth() then decimate(), the progress before each, the reports of both.
+TEST(RefineSurface, SmoothsThenDecimatesAsTheTwoCalls) {
+  const NoisyPhantom p = makeNoisySphere(24, 0.0);
+  const Surface extracted = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::largest(), Mapping::Midpoint);
+  Surface one = extracted, two = extracted;
+  DecimateOptions d;
+  d.maxError = 0.5;
+  smooth(one, {});
+  decimate(one, d);
+  RefineOptions o;
+  o.smooth = SmoothOptions{};
+  o.decimate = d;
+  std::vector<std::string> stages;
+  o.progress = [&](const ProgressEvent& e) { stages.push_back(e.stage + std::to_string(e.index) + std::to_string(e.stages)); };
+  const RefineReport r = refineSurface(two, o);
+  EXPECT_EQ(stages, (std::vector<std::string>{"smooth02", "decimate12"}));
+  EXPECT_EQ(two.triangles, one.triangles);
+  EXPECT_EQ(two.vertices, one.vertices);
+  ASSERT_TRUE(r.smooth && r.decimate);
+  EXPECT_EQ(r.volumeBefore, r.smooth->volumeBefore);
+  EXPECT_EQ(r.volumeAfter, r.decimate->volumeAfter);
+  EXPECT_LT(r.decimate->trianglesAfter, r.decimate->trianglesBefore);
+  // Nothing asked: nothing changes.
+  Surface three = extracted;
+  const RefineReport none = refineSurface(three, {});
+  EXPECT_FALSE(none.smooth || none.decimate);
+  EXPECT_EQ(three.vertices, extracted.vertices);
+}

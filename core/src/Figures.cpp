@@ -5,17 +5,14 @@
 
 #include "Extract.h"
 #include "MeshComponents.h"
+#include "VertexNormals.h"
 
 namespace surftrack {
 namespace {
 
 using Point = std::array<double, 3>;
-
-Point cross(const Point& a, const Point& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Point minus(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using refine::cross;
+using refine::dot;
 
 }  // namespace
 
@@ -30,7 +27,7 @@ std::vector<ComponentFigures> componentFigures(const std::vector<Point>& vertice
     ComponentFigures& f = figures[label[t[0]]];
     ++f.triangles;
     const Point& a = vertices[t[0]];
-    const Point n = cross(minus(vertices[t[1]], a), minus(vertices[t[2]], a));
+    const Point n = refine::triangleNormal({a, vertices[t[1]], vertices[t[2]]});
     f.area += 0.5 * std::sqrt(dot(n, n));
     // Divergence theorem: the signed volume of the tetrahedron (0, a, b, c), summed.
     f.volume += dot(a, cross(vertices[t[1]], vertices[t[2]])) / 6.0;
@@ -58,13 +55,8 @@ std::vector<ComponentFigures> componentFigures(const std::vector<Point>& vertice
 }
 
 std::vector<Point> vertexNormals(const Surface& surface) {
-  std::vector<Point> normals(surface.vertices.size(), Point{0, 0, 0});
-  for (const auto& t : surface.triangles) {
-    const Point& a = surface.vertices[t[0]];
-    const Point n = cross(minus(surface.vertices[t[1]], a), minus(surface.vertices[t[2]], a));
-    for (std::uint32_t v : t)
-      for (int k = 0; k < 3; ++k) normals[v][k] += n[k];  // |n| = 2 area: area-weighted
-  }
+  std::vector<Point> normals;
+  refine::sumTriangleNormals(surface.vertices, surface.triangles, normals);  // area-weighted
   for (Point& n : normals) {
     const double length = std::sqrt(dot(n, n));
     if (length > 0)

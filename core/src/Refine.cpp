@@ -81,6 +81,7 @@ SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
   report.iterations = o.iterations;
   report.cubes = r.cubes;
   report.unguardedCubes = r.unguardedCubes;
+  report.checkedCubes = r.checkedCubes;
   report.stepsBack = r.stepsBack;
   report.maxDisplacement = r.maxDisplacement;
   report.volumeAfter = storedVolume(surface);
@@ -103,6 +104,30 @@ DecimateReport decimate(Surface& surface, const DecimateOptions& o) {
   report.trianglesAfter = r.trianglesAfter;
   report.targetTriangles = r.targetTriangles;
   report.volumeAfter = storedVolume(surface);
+  return report;
+}
+
+RefineReport refineSurface(Surface& surface, const RefineOptions& o) {
+  RefineReport report;
+  const int steps = int(o.smooth.has_value()) + int(o.decimate.has_value());
+  int step = 0;
+  auto starting = [&](const char* stage) {
+    if (o.progress) o.progress(ProgressEvent{stage, step++, steps, 0});
+  };
+  if (o.smooth) {
+    starting("smooth");
+    report.smooth = smooth(surface, *o.smooth);
+  }
+  if (o.decimate) {
+    starting("decimate");
+    report.decimate = decimate(surface, *o.decimate);
+  }
+  if (report.smooth) report.volumeBefore = report.smooth->volumeBefore;
+  else if (report.decimate) report.volumeBefore = report.decimate->volumeBefore;
+  else report.volumeBefore = volumeOf(surface);
+  if (report.decimate) report.volumeAfter = report.decimate->volumeAfter;
+  else if (report.smooth) report.volumeAfter = report.smooth->volumeAfter;
+  else report.volumeAfter = report.volumeBefore;
   return report;
 }
 

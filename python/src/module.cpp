@@ -180,22 +180,23 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
 
   auto r = std::make_shared<Result>();
   r->order = order;
-  std::optional<SmoothReport> smoothed;
-  std::optional<DecimateReport> decimated;
+  RefineOptions ro;
+  if (smoothIterations > 0) {
+    SmoothOptions so;
+    so.iterations = smoothIterations;
+    ro.smooth = so;
+  }
+  if (maxError || reduction) {
+    DecimateOptions d;
+    d.maxError = maxError;
+    d.reduction = reduction;
+    ro.decimate = d;
+  }
+  RefineReport refined;
   {
     py::gil_scoped_release release;
     r->surface = extract(view, o);
-    if (smoothIterations > 0) {
-      SmoothOptions so;
-      so.iterations = smoothIterations;
-      smoothed = smooth(r->surface, so);
-    }
-    if (maxError || reduction) {
-      DecimateOptions d;
-      d.maxError = maxError;
-      d.reduction = reduction;
-      decimated = decimate(r->surface, d);
-    }
+    refined = refineSurface(r->surface, ro);
   }
   py::dict out = surfaceDict(r);
   const Surface& s = r->surface;
@@ -211,22 +212,21 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     if (s.seed.distance) out["seed_distance"] = *s.seed.distance;
   }
   out["warnings"] = s.warnings;
-  if (smoothed || decimated) {
-    py::dict refine;
-    if (smoothed) {
-      refine["smooth_iterations"] = smoothed->iterations;
-      refine["max_vertex_displacement"] = smoothed->maxDisplacement;
-      refine["steps_back"] = smoothed->stepsBack;
-      refine["unguarded_cubes"] = smoothed->unguardedCubes;
-      refine["volume_before"] = smoothed->volumeBefore;
+  if (refined.smooth || refined.decimate) {
+    py::dict summary;
+    if (const auto& smoothed = refined.smooth) {
+      summary["smooth_iterations"] = smoothed->iterations;
+      summary["max_vertex_displacement"] = smoothed->maxDisplacement;
+      summary["steps_back"] = smoothed->stepsBack;
+      summary["unguarded_cubes"] = smoothed->unguardedCubes;
     }
-    if (decimated) {
-      refine["triangles_before"] = decimated->trianglesBefore;
-      refine["triangles_after"] = decimated->trianglesAfter;
-      if (!smoothed) refine["volume_before"] = decimated->volumeBefore;
+    if (const auto& decimated = refined.decimate) {
+      summary["triangles_before"] = decimated->trianglesBefore;
+      summary["triangles_after"] = decimated->trianglesAfter;
     }
-    refine["volume_after"] = decimated ? decimated->volumeAfter : smoothed->volumeAfter;
-    out["refine"] = refine;
+    summary["volume_before"] = refined.volumeBefore;
+    summary["volume_after"] = refined.volumeAfter;
+    out["refine"] = summary;
   }
   return out;
 }

@@ -7,9 +7,12 @@
 //   surftrack::smooth(s, {});                               // 20 Taubin lambda|mu iterations
 //   surftrack::DecimateOptions d;  d.maxError = 0.5;  d.reduction = 0.9;
 //   surftrack::decimate(s, d);
+//   // or both, as the CLI and Python do:
+//   surftrack::refineSurface(s, {surftrack::SmoothOptions{}, d});
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 
 #include "Extract.h"
@@ -27,6 +30,7 @@ struct SmoothReport {
   int iterations = 0;
   std::size_t cubes = 0;           ///< digital 3-cubes holding triangles
   std::size_t unguardedCubes = 0;  ///< cubes not embedded before smoothing (left unchecked)
+  std::size_t checkedCubes = 0;    ///< cubes tested in the passes (the others have certificates)
   std::size_t stepsBack = 0;       ///< vertex moves halved or undone by the fold check
   double maxDisplacement = 0;      ///< physical units
   double volumeBefore = 0, volumeAfter = 0;  ///< signed enclosed volume, physical units^3
@@ -61,5 +65,24 @@ SmoothReport smooth(Surface& surface, const SmoothOptions& options = {});
 /// are recomputed.
 /// \throw InvalidInput for options out of range, or neither a maxError nor a reduction.
 DecimateReport decimate(Surface& surface, const DecimateOptions& options);
+
+/// Smoothing, then decimation, each if asked (the CLI's --smooth, --max-error, --reduce and
+/// Python's smooth=, max_error=, reduce=).
+struct RefineOptions {
+  std::optional<SmoothOptions> smooth;      ///< nothing: no smoothing
+  std::optional<DecimateOptions> decimate;  ///< nothing: no decimation
+  /// Called before each step: stage "smooth" or "decimate", index among the steps asked.
+  std::function<void(const ProgressEvent&)> progress;
+};
+
+struct RefineReport {
+  std::optional<SmoothReport> smooth;
+  std::optional<DecimateReport> decimate;
+  double volumeBefore = 0, volumeAfter = 0;  ///< before the first step, after the last
+};
+
+/// smooth() then decimate() of `surface` as `options` asks (nothing asked: nothing changes).
+/// \throw InvalidInput as smooth() and decimate() do.
+RefineReport refineSurface(Surface& surface, const RefineOptions& options);
 
 }  // namespace surftrack
