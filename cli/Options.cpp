@@ -351,9 +351,11 @@ bool looksLikeOption(const std::string& s) {
   return s.size() > 1 && s[0] == '-' && !numeric;
 }
 
-/// The first argument CLI11 did not take: an unknown option, or a second input volume (CLI11
-/// also leaves there a "--" after which no positional was expected).
-void rejectExtras(const CLI::App& app, const std::string& command) {
+/// The first argument CLI11 did not take: an unknown option, or a positional the command does
+/// not take (`positional` says what it does take). CLI11 also leaves there a "--" after which no
+/// positional was expected.
+void rejectExtras(const CLI::App& app, const std::string& command,
+                  const std::string& positional = "one input volume only") {
   bool afterMark = false;
   for (const std::string& arg : app.remaining()) {
     if (arg == "--" && !afterMark) {
@@ -363,7 +365,7 @@ void rejectExtras(const CLI::App& app, const std::string& command) {
     if (!afterMark && looksLikeOption(arg))
       throw UsageError("unknown option '" + (arg.rfind("--", 0) == 0 ? arg.substr(0, arg.find('=')) : arg) +
                        "' for 'surftrack " + command + "'");
-    throw UsageError("unexpected argument '" + arg + "' (one input volume only)");
+    throw UsageError("unexpected argument '" + arg + "' (" + positional + ")");
   }
 }
 
@@ -689,10 +691,7 @@ DemoOptions parseDemoOptions(const std::vector<std::string>& args) {
   CLI::App app;
   defineDemo(app, o);
   parse(app, args);
-  for (const std::string& arg : app.remaining())
-    if (arg != "--")
-      throw UsageError("unknown argument '" + (arg.rfind("--", 0) == 0 ? arg.substr(0, arg.find('=')) : arg) +
-                       "' for 'surftrack demo'");
+  rejectExtras(app, "demo", "the demo reads no input");
   return o;
 }
 

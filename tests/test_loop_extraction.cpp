@@ -28,11 +28,6 @@
 #include "TrackComponent.h"
 #include "VoxelComponents.h"
 
-namespace surftrack {
-// gtest prints the parameter of AllPairs/... as "26-6" instead of its bytes.
-inline void PrintTo(AdjacencyPair pair, std::ostream* os) { *os << toString(pair); }
-}  // namespace surftrack
-
 using namespace surftrack;
 namespace ref = surftrack::testing;
 using Point = std::array<double, 3>;
