@@ -187,8 +187,10 @@ bool shortFan(const std::uint32_t* c, const std::uint32_t* vertexAt, std::uint32
   static_assert(D >= 1 && D <= 8);
   constexpr std::uint32_t kNone = ~std::uint32_t(0), kDead = 8;
   alignas(16) std::uint32_t a[8] = {kNone, kNone, kNone, kNone, kNone, kNone, kNone, kNone};
-  std::uint32_t b[D], out[kDead + 1], in[D], follower[kDead + 1];
-  out[kDead] = deadEnd, follower[kDead] = kDead;
+  // The walk may reach the dead end (a corner with no follower): it has an entry in each array
+  // it indexes, so that a fan that is not one cycle reads and writes only its own slots.
+  std::uint32_t b[D], out[kDead + 1], in[kDead + 1], follower[kDead + 1];
+  out[kDead] = deadEnd, in[kDead] = deadEnd, follower[kDead] = kDead;
   for (std::uint32_t i = 0; i < D; ++i) {
     // Directed edge o = 3f + j is also where t[j] is in the triangles seen as one array.
     const std::uint32_t j = c[i] & 3, o = 3 * (c[i] >> 2) + j;

@@ -1,5 +1,6 @@
-// libFuzzer target: arbitrary bytes as a volume file of one format (FUZZ_FORMAT: "mha", "mhd",
-// "nrrd", "nhdr", "nii" or "raw"), built once per format (fuzz/CMakeLists.txt).
+// libFuzzer target: arbitrary bytes as a volume file of one format, "mha", "mhd", "nrrd",
+// "nhdr", "nii" or "raw", named by the program's name: fuzz_volume_header_<format> (one binary,
+// one link to it per format, fuzz/CMakeLists.txt).
 //
 // Each input goes through
 //  1. the format's header parser (io/VolumeHeader.h) on the input buffer itself, whole and cut
@@ -28,21 +29,17 @@
 #include "ReadVolume.h"
 #include "VolumeHeader.h"
 
-#ifndef FUZZ_FORMAT
-#error "define FUZZ_FORMAT as \"mha\", \"mhd\", \"nrrd\", \"nhdr\", \"nii\" or \"raw\""
-#endif
-
 namespace {
 
 namespace fs = std::filesystem;
 using namespace surftrack;
 
-constexpr std::string_view kFormat = FUZZ_FORMAT;
+std::string gFormat;  // from the program's name, set once by LLVMFuzzerInitialize
 
 std::string gInput;  // the file that holds each input
 
 void fail(const std::string& what) {
-  std::fprintf(stderr, "fuzz_volume_header (%s): %s\n", FUZZ_FORMAT, what.c_str());
+  std::fprintf(stderr, "fuzz_volume_header (%s): %s\n", gFormat.c_str(), what.c_str());
   std::abort();
 }
 
@@ -91,8 +88,8 @@ void requireSame(const io::LoadedVolume& loaded, const io::AnyVolume& read) {
 
 void parseBuffer(std::string_view bytes) {
   using Parse = std::optional<io::DataLayout> (*)(std::string_view, std::uint64_t);
-  Parse parse = kFormat == "nii" ? io::parseNifti1Header
-              : kFormat == "mha" || kFormat == "mhd" ? io::parseMetaImageHeader
+  Parse parse = gFormat == "nii" ? io::parseNifti1Header
+              : gFormat == "mha" || gFormat == "mhd" ? io::parseMetaImageHeader
                                                      : io::parseNrrdHeader;
   for (std::string_view head : {bytes, bytes.substr(0, bytes.size() / 2)}) {
     try {
@@ -150,13 +147,19 @@ void fuzzFile(const uint8_t* data, size_t size) {
 
 }  // namespace
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
+extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
+  const std::string name = *argc > 0 ? fs::path((*argv)[0]).filename().string() : "";
+  const std::string prefix = "fuzz_volume_header_";
+  gFormat = name.rfind(prefix, 0) == 0 ? name.substr(prefix.size()) : "";
+  if (gFormat != "mha" && gFormat != "mhd" && gFormat != "nrrd" && gFormat != "nhdr" && gFormat != "nii" &&
+      gFormat != "raw")
+    fail("run me as fuzz_volume_header_<format>, format mha, mhd, nrrd, nhdr, nii or raw (not '" + name + "')");
   // One directory per process (libFuzzer's -jobs/-workers run several): under /dev/shm when
   // there is one, so that the inputs never reach a disk.
   const fs::path base = fs::exists("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
   std::string dir = (base / "surftrack-fuzz-XXXXXX").string();
   if (!::mkdtemp(dir.data())) fail("mkdtemp failed");
-  gInput = (fs::path(dir) / ("input." + std::string(kFormat))).string();
+  gInput = (fs::path(dir) / ("input." + std::string(gFormat))).string();
   std::string data(65536, '\0');
   for (std::size_t i = 0; i < data.size(); ++i) data[i] = char(i * 131 + (i >> 8));
   std::ofstream(fs::path(dir) / "data.raw", std::ios::binary).write(data.data(), std::streamsize(data.size()));
@@ -170,7 +173,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size > (1 << 20)) return 0;
-  if (kFormat == "raw")
+  if (gFormat == "raw")
     fuzzRaw(data, size);
   else
     fuzzFile(data, size);

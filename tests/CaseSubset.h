@@ -3,6 +3,7 @@
 // fixed subset of their cases, about one in kCaseStride, picked by a hash of the case number so
 // that the subset is spread over the configurations rather than a prefix of them: every code path
 // those tests reach still runs under the sanitizers. The normal build checks every case.
+// Tests of one whole volume take a smaller one there (inputSize).
 #pragma once
 
 #include <cstdint>
@@ -10,10 +11,16 @@
 namespace surftrack::testing {
 
 #ifdef SURFTRACK_SANITIZED
+inline constexpr bool kSanitizedBuild = true;
 inline constexpr unsigned kCaseStride = 8;
 #else
+inline constexpr bool kSanitizedBuild = false;
 inline constexpr unsigned kCaseStride = 1;
 #endif
+
+/// The size of a test's input: `normal` in the normal build, the smaller `sanitized` in the
+/// sanitized one (for the tests whose one input is a whole volume rather than many cases).
+constexpr int inputSize(int normal, int sanitized) { return kSanitizedBuild ? sanitized : normal; }
 
 /// Whether case i is checked in this build: always in the normal build; case 0 and about one in
 /// kCaseStride of the others (splitmix64 of i) in the sanitized build.

@@ -42,6 +42,21 @@ void operator delete(void* p) noexcept {
   std::free(base);
 }
 void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
+// The other forms, so that every block is made and freed by the pair above (the sanitizer
+// runtime would otherwise serve, say, the nothrow form that std::stable_sort uses).
+void* operator new[](std::size_t n) { return operator new(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  try {
+    return operator new(n);
+  } catch (const std::bad_alloc&) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t n, const std::nothrow_t& t) noexcept { return operator new(n, t); }
+void operator delete[](void* p) noexcept { operator delete(p); }
+void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { operator delete(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { operator delete(p); }
 
 namespace {
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "CaseSubset.h"
 #include "CgalMeshChecks.h"
 #include "ConfigurationTable.h"
 #include "DigitalCube.h"
@@ -135,6 +136,7 @@ TEST_P(RefineRandomImages, SmoothingAndDecimationKeepTopologyAndSides) {
     DenseImage<std::uint8_t> image(dims);
     for (auto& v : image.data()) v = std::uniform_real_distribution<double>(0, 1)(rng) < density;
     if (std::count(image.data().begin(), image.data().end(), 1) == 0) continue;
+    if (!surftrack::testing::caseChecked(std::uint64_t(trial))) continue;
     const std::string what = "trial " + std::to_string(trial);
     Surface s = extractAll(image, pair);
     const Shape before = shapeOf(s);
@@ -226,7 +228,7 @@ Surface extractFrom(const DenseImage<T>& image, Selection selection, SeedRule se
 
 // The noisy sphere of Figure 9 (q = 64, 1 % noise): every boundary, midpoint and linear mappings.
 TEST(RefineVolumes, Figure9NoisySphere) {
-  const NoisyPhantom p = makeNoisySphere(64, 0.01);
+  const NoisyPhantom p = makeNoisySphere(surftrack::testing::inputSize(64, 32), 0.01);
   const auto binary = p.binary();
   checkSmoothThenDecimate(extractFrom(p.image, Selection::threshold(p.iso), SeedRule::all(), Mapping::Midpoint),
                           binary, 0.5, 0.8, "sphere, midpoint");
@@ -323,7 +325,7 @@ TEST(RefineVolumes, MriCortexBlock) {
   const std::string path = std::string(SURFTRACK_TEST_MRICRON) + "/ch2better.nii.gz";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
   const auto volume = std::get<DenseImage<std::uint8_t>>(io::readVolume(path));
-  const DenseImage<std::uint8_t> block = crop(volume, {118, 158, 208}, 56);
+  const DenseImage<std::uint8_t> block = crop(volume, {118, 158, 208}, surftrack::testing::inputSize(56, 32));
   const ThresholdImage<std::uint8_t> binary(block, 100.0);
   checkSmoothThenDecimate(extractFrom(block, Selection::threshold(100), SeedRule::all()), binary, 0.25, 0.7,
                           "MRI block");

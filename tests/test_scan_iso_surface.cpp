@@ -163,7 +163,7 @@ TEST(ScanIsoSurface, VerticesAreTheBoundarySurfelsAndTheMeshIsClosedAndOriented)
             << toString(pair) << " " << d.nx << "x" << d.ny << "x" << d.nz;
       }
   }
-  EXPECT_EQ(images, 600);
+  EXPECT_GE(images, 4 * int(surftrack::testing::subsetMinimum(150)));  // the random images were made
 }
 
 // Count, prefix sum, fill in runs of slabs: the mesh does not depend on the number of threads,
