@@ -34,6 +34,9 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "AdjacencyPair.h"
 #include "ConfigurationTable.h"
@@ -122,6 +125,73 @@ inline void forEachNonZero(const std::uint8_t* bytes, int n, F&& f) {
   }
   for (; i < n; ++i)
     if (bytes[i]) f(i);
+}
+
+/// dirs[x] for x in [0, nx): the surfel directions of voxel x of a row (bit n: its neighbour
+/// along direction n holds another label; n = 2 axis + (sign < 0): +x, -x, +y, -y, +z, -z),
+/// 0 for a voxel of no label. `here`, `above`, `below`: the row in its plane and in the planes
+/// z + 1 and z - 1, rows w apart. Without a branch (the compiler vectorises it).
+inline void rowDirections(const std::uint32_t* __restrict here, const std::uint32_t* __restrict above,
+                          const std::uint32_t* __restrict below, std::size_t w, int nx,
+                          std::uint8_t* __restrict dirs) {
+  for (int x = 0; x < nx; ++x) {
+    const std::uint32_t L = here[x];
+    const unsigned mask = unsigned(here[x + 1] != L) | unsigned(here[x - 1] != L) << 1 |
+                          unsigned(here[x + w] != L) << 2 | unsigned(here[x - w] != L) << 3 |
+                          unsigned(above[x] != L) << 4 | unsigned(below[x] != L) << 5;
+    dirs[x] = std::uint8_t(L == kNone ? 0u : mask);
+  }
+}
+
+/// mixed[i] for i in [0, w - 1): whether the cube between columns i and i + 1 of two rows of
+/// plane lo (w apart) and the same rows of plane hi holds two labels (or a label and none):
+/// its corner column i or i + 1 does, or the two columns differ. Without a branch (vectorised).
+inline void rowMixed(const std::uint32_t* __restrict lo, const std::uint32_t* __restrict hi, std::size_t w,
+                     std::uint8_t* __restrict mixed) {
+  for (std::size_t i = 0; i < w; ++i) {
+    const std::uint32_t a = lo[i];
+    mixed[i] = std::uint8_t((a != lo[i + w]) | (a != hi[i]) | (a != hi[i + w]));
+  }
+  for (std::size_t i = 0; i + 1 < w; ++i) mixed[i] = std::uint8_t(mixed[i] | mixed[i + 1] | (lo[i] != lo[i + 1]));
+}
+
+/// f(L, config) for each label L (not kNone) on the corners of the cube at index p of two
+/// planes `lo` and `hi` (corner i: plane bit 2, row bit 1, column bit 0; rows w apart), in the
+/// order of their first corner; config: bit i set where corner i holds L.
+template <class F>
+inline void forEachCubeLabel(const std::uint32_t* lo, const std::uint32_t* hi, std::size_t p, std::size_t w, F&& f) {
+#if defined(__SSE2__)
+  const __m128i low = _mm_unpacklo_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(lo + p)),
+                                         _mm_loadl_epi64(reinterpret_cast<const __m128i*>(lo + p + w)));
+  const __m128i high = _mm_unpacklo_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(hi + p)),
+                                          _mm_loadl_epi64(reinterpret_cast<const __m128i*>(hi + p + w)));
+  auto holding = [&](std::uint32_t L) {
+    const __m128i v = _mm_set1_epi32(int(L));
+    return unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(low, v)))) |
+           unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(high, v)))) << 4;
+  };
+  std::uint32_t corner[8];
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(corner), low);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(corner + 4), high);
+  for (unsigned todo = ~holding(kNone) & 0xFFu; todo;) {
+    const std::uint32_t L = corner[std::countr_zero(todo)];
+    const unsigned config = holding(L);
+    todo &= ~config;
+    f(L, config);
+  }
+#else
+  const std::uint32_t corner[8] = {lo[p], lo[p + 1], lo[p + w], lo[p + w + 1],
+                                   hi[p], hi[p + 1], hi[p + w], hi[p + w + 1]};
+  unsigned done = 0;
+  for (int i = 0; i < 8; ++i) {
+    const std::uint32_t L = corner[i];
+    if (L == kNone || (done >> i & 1)) continue;
+    unsigned config = 0;
+    for (int j = i; j < 8; ++j) config |= unsigned(corner[j] == L) << j;
+    done |= config;
+    f(L, config);
+  }
+#endif
 }
 
 /// One pass over one slab (kFill: the fill pass, else the count pass). Per-voxel planes: labels
@@ -238,16 +308,7 @@ class SlabScanner {
     const std::size_t w = width_;
     for (int y = 0; y < dims.ny; ++y) {
       const std::size_t rowStart = std::size_t(y + 1) * w + 1;
-      // The directions of every voxel of the row first, without a branch (the compiler
-      // vectorises it); direction n = 2 axis + (sign < 0): +x, -x, +y, -y, +z, -z.
-      for (int x = 0; x < dims.nx; ++x) {
-        const std::size_t i = rowStart + std::size_t(x);
-        const std::uint32_t L = here[i];
-        const unsigned mask = unsigned(here[i + 1] != L) | unsigned(here[i - 1] != L) << 1 |
-                              unsigned(here[i + w] != L) << 2 | unsigned(here[i - w] != L) << 3 |
-                              unsigned(above[i] != L) << 4 | unsigned(below[i] != L) << 5;
-        dirs[i] = std::uint8_t(L == kNone ? 0u : mask);
-      }
+      rowDirections(here + rowStart, above + rowStart, below + rowStart, w, dims.nx, dirs + rowStart);
       if constexpr (!kFill) {
         forEachNonZero(dirs + rowStart, dims.nx, [&](int x) {
           const std::size_t i = rowStart + std::size_t(x);
@@ -255,6 +316,7 @@ class SlabScanner {
         });
       } else {
         std::uint32_t* counters = owned ? counters_.data() : nextCounters_.data();
+        const Mapping mapping = *mapping_;  // a local copy: the stores below cannot alias it
         forEachNonZero(dirs + rowStart, dims.nx, [&](int x) {
           const std::size_t i = rowStart + std::size_t(x);
           const std::uint32_t L = here[i];
@@ -264,10 +326,12 @@ class SlabScanner {
           counters[L] = n + std::uint32_t(std::popcount(mask));
           if (owned) {
             const LabelMeshArrays& to = (*out_)[L];
+            __builtin_prefetch(to.surfels + n + 16, 1);
+            __builtin_prefetch(to.points + n + 12, 1);
             for (unsigned m = mask; m; m &= m - 1, ++n) {
               const Surfel s{Voxel{x, y, z}, Direction(std::countr_zero(m))};
               to.surfels[n] = s;
-              to.points[n] = (*mapping_)(s);
+              to.points[n] = mapping(s);
             }
           }
         });
@@ -283,30 +347,17 @@ class SlabScanner {
     const std::size_t w = width_;
     // Corner i of the cube at index p (x + 1, y + 1): plane bit 2, row bit 1, column bit 0.
     const std::size_t offset[8] = {0, 1, w, w + 1, 0, 1, w, w + 1};
+    const std::uint32_t* first[2] = {first_[0].data(), first_[1].data()};
+    const std::uint8_t* dirs[2] = {directions_[0].data(), directions_[1].data()};
     const Dims& dims = image_.dims;
     mixed_.resize(width_ + 8);
     for (int y = -1; y < dims.ny; ++y) {
       const std::size_t rowStart = std::size_t(y + 1) * w;
-      // Cube x + 1 of the row holds two labels (or a label and none) when its corner column x
-      // or x + 1 does, or the two columns differ; without a branch first (vectorised).
       std::uint8_t* mixed = mixed_.data();
-      for (std::size_t i = 0; i < w; ++i) {
-        const std::uint32_t a = lo[rowStart + i];
-        mixed[i] = std::uint8_t((a != lo[rowStart + i + w]) | (a != hi[rowStart + i]) | (a != hi[rowStart + i + w]));
-      }
-      for (std::size_t i = 0; i + 1 < w; ++i)
-        mixed[i] = std::uint8_t(mixed[i] | mixed[i + 1] | (lo[rowStart + i] != lo[rowStart + i + 1]));
+      rowMixed(lo + rowStart, hi + rowStart, w, mixed);
       forEachNonZero(mixed, int(w) - 1, [&](int column) {
         const std::size_t p = rowStart + std::size_t(column);
-        std::uint32_t corner[8];
-        for (int i = 0; i < 8; ++i) corner[i] = (i < 4 ? lo : hi)[p + offset[i]];
-        unsigned done = 0;
-        for (int i = 0; i < 8; ++i) {
-          const std::uint32_t L = corner[i];
-          if (L == kNone || (done >> i & 1)) continue;
-          unsigned config = 0;
-          for (int j = i; j < 8; ++j) config |= unsigned(corner[j] == L) << j;
-          done |= config;
+        forEachCubeLabel(lo, hi, p, w, [&](std::uint32_t L, unsigned config) {
           const Config& entry = table_[config];
           if constexpr (!kFill) {
             slab_.triangles[L] += std::uint64_t(entry.triangles);
@@ -314,13 +365,14 @@ class SlabScanner {
             auto vertex = [&](std::uint16_t corner) {
               const int c = corner & 7, k = c >> 2;
               const std::size_t at = p + offset[c];
-              return first_[k][at] + std::uint32_t(std::popcount(unsigned(directions_[k][at] & (corner >> 3))));
+              return first[k][at] + std::uint32_t(std::popcount(unsigned(dirs[k][at] & (corner >> 3))));
             };
             std::array<std::uint32_t, 3>*& to = triangles_[L];
+            __builtin_prefetch(to + 24, 1);  // the arrays were zeroed long ago: fetch ahead for writing
             for (int t = 0; t < entry.triangles; ++t)
               *to++ = {vertex(entry.corners[t][0]), vertex(entry.corners[t][1]), vertex(entry.corners[t][2])};
           }
-        }
+        });
       });
     }
   }
