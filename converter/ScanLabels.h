@@ -127,6 +127,25 @@ inline void forEachNonZero(const std::uint8_t* bytes, int n, F&& f) {
     if (bytes[i]) f(i);
 }
 
+/// The end of a run of `value` in a contiguous row of n values, from x on: the first i >= x
+/// with row[i] != value, or n; 16 bytes at a time.
+template <class T>
+inline int runEnd(const T* row, int x, int n, T value) {
+#if defined(__SSE2__)
+  constexpr int kLanes = int(16 / sizeof(T));
+  T lanes[kLanes];
+  std::fill(lanes, lanes + kLanes, value);
+  const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(lanes));
+  for (; x + kLanes <= n; x += kLanes) {
+    const __m128i r = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + x));
+    const auto same = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(r, v)));  // bit b: byte b equal
+    if (same != 0xFFFFu) return x + std::countr_zero(~same) / int(sizeof(T));
+  }
+#endif
+  while (x < n && row[x] == value) ++x;
+  return x;
+}
+
 /// dirs[x] for x in [0, nx): the surfel directions of voxel x of a row (bit n: its neighbour
 /// along direction n holds another label; n = 2 axis + (sign < 0): +x, -x, +y, -y, +z, -z),
 /// 0 for a voxel of no label. `here`, `above`, `below`: the row in its plane and in the planes
@@ -280,7 +299,11 @@ class SlabScanner {
       while (x < dims.nx) {
         const T value = row[x * sx];
         const int start = x;
-        while (++x < dims.nx && row[x * sx] == value) {
+        if (sx == 1) {
+          x = runEnd(row, x + 1, dims.nx, value);
+        } else {
+          while (++x < dims.nx && row[x * sx] == value) {
+          }
         }
         const std::uint32_t L = labelIndex(value);
         std::fill(out + start, out + x, L);
