@@ -67,26 +67,35 @@ namespace scanlabels {
 
 inline constexpr std::uint32_t kNone = ~std::uint32_t(0);  ///< background, unwanted, outside
 
-/// A configuration's triangles, each vertex as the L-corner c of its cube edge (bits 0-2) and
-/// the directions of that corner's surfels numbered before it (bits 3-8: those below the edge's
-/// direction), so that a vertex is first + popcount(directions & mask) of its corner.
+/// A configuration's triangles over its distinct vertices: each vertex as the L-corner c of
+/// its cube edge (bits 0-2) and the directions of that corner's surfels numbered before it
+/// (bits 3-8: those below the edge's direction), so that a vertex is first + popcount(directions
+/// & mask) of its corner; each triangle as three indices into the vertices.
 struct Config {
-  int triangles = 0;
-  std::array<std::array<std::uint16_t, 3>, CubeTriangulation::kMaxTriangles> corners{};
+  int triangles = 0, vertices = 0;
+  std::array<std::uint16_t, 12> vertex{};
+  std::array<std::array<std::uint8_t, 3>, CubeTriangulation::kMaxTriangles> corners{};
 };
 
 inline std::array<Config, 256> configTable(AdjacencyPair pair) {
   std::array<Config, 256> out;
   for (int config = 0; config < 256; ++config) {
     const CubeTriangulation& t = configurationTable(pair, std::uint8_t(config));
-    out[config].triangles = t.triangleCount;
+    Config& c = out[config];
+    c.triangles = t.triangleCount;
+    std::array<int, 12> indexOfEdge;
+    indexOfEdge.fill(-1);
     for (int i = 0; i < t.triangleCount; ++i)
       for (int j = 0; j < 3; ++j) {
         const int edge = t.triangles[i][j];
-        const int low = cube::edgeLowCorner(edge), high = cube::edgeHighCorner(edge);
-        const bool lowIsL = config >> low & 1;
-        const int n = directionOf(cube::edgeAxis(edge), lowIsL ? +1 : -1);
-        out[config].corners[i][j] = std::uint16_t((lowIsL ? low : high) | ((1u << n) - 1) << 3);
+        if (indexOfEdge[edge] < 0) {
+          const int low = cube::edgeLowCorner(edge), high = cube::edgeHighCorner(edge);
+          const bool lowIsL = config >> low & 1;
+          const int n = directionOf(cube::edgeAxis(edge), lowIsL ? +1 : -1);
+          indexOfEdge[edge] = c.vertices;
+          c.vertex[std::size_t(c.vertices++)] = std::uint16_t((lowIsL ? low : high) | ((1u << n) - 1) << 3);
+        }
+        c.corners[i][j] = std::uint8_t(indexOfEdge[edge]);
       }
   }
   return out;
@@ -385,15 +394,19 @@ class SlabScanner {
           if constexpr (!kFill) {
             slab_.triangles[L] += std::uint64_t(entry.triangles);
           } else {
-            auto vertex = [&](std::uint16_t corner) {
-              const int c = corner & 7, k = c >> 2;
+            std::uint32_t vertex[12];
+            for (int v = 0; v < entry.vertices; ++v) {
+              const unsigned code = entry.vertex[std::size_t(v)];
+              const unsigned c = code & 7, k = c >> 2;
               const std::size_t at = p + offset[c];
-              return first[k][at] + std::uint32_t(std::popcount(unsigned(dirs[k][at] & (corner >> 3))));
-            };
+              vertex[v] = first[k][at] + std::uint32_t(std::popcount(unsigned(dirs[k][at]) & (code >> 3)));
+            }
             std::array<std::uint32_t, 3>*& to = triangles_[L];
             __builtin_prefetch(to + 24, 1);  // the arrays were zeroed long ago: fetch ahead for writing
-            for (int t = 0; t < entry.triangles; ++t)
-              *to++ = {vertex(entry.corners[t][0]), vertex(entry.corners[t][1]), vertex(entry.corners[t][2])};
+            for (int t = 0; t < entry.triangles; ++t) {
+              const auto& corners = entry.corners[std::size_t(t)];
+              *to++ = {vertex[corners[0]], vertex[corners[1]], vertex[corners[2]]};
+            }
           }
         });
       });

@@ -22,15 +22,28 @@ std::vector<ComponentFigures> componentFigures(const std::vector<Point>& vertice
   std::size_t count = 0;
   std::vector<std::uint32_t> label = triangleComponents(vertices.size(), triangles, count);
   std::vector<ComponentFigures> figures(count);
-  for (std::uint32_t c : label) ++figures[c].surfels;
-  for (const auto& t : triangles) {
-    ComponentFigures& f = figures[label[t[0]]];
-    ++f.triangles;
+  // Divergence theorem: the signed volume of the tetrahedron (0, a, b, c), summed.
+  auto add = [&](const std::array<std::uint32_t, 3>& t, double& area, double& volume) {
     const Point& a = vertices[t[0]];
     const Point n = refine::triangleNormal({a, vertices[t[1]], vertices[t[2]]});
-    f.area += 0.5 * std::sqrt(dot(n, n));
-    // Divergence theorem: the signed volume of the tetrahedron (0, a, b, c), summed.
-    f.volume += dot(a, cross(vertices[t[1]], vertices[t[2]])) / 6.0;
+    area += 0.5 * std::sqrt(dot(n, n));
+    volume += dot(a, cross(vertices[t[1]], vertices[t[2]])) / 6.0;
+  };
+  if (count == 1) {  // one boundary, the most frequent case: the sums in registers, same order
+    ComponentFigures& f = figures[0];
+    f.surfels = vertices.size();
+    f.triangles = triangles.size();
+    double area = 0, volume = 0;
+    for (const auto& t : triangles) add(t, area, volume);
+    f.area = area;
+    f.volume = volume;
+  } else {
+    for (std::uint32_t c : label) ++figures[c].surfels;
+    for (const auto& t : triangles) {
+      ComponentFigures& f = figures[label[t[0]]];
+      ++f.triangles;
+      add(t, f.area, f.volume);
+    }
   }
   for (ComponentFigures& f : figures) {
     f.edges = 3 * f.triangles / 2;  // a closed surface: every edge borders two triangles
