@@ -74,7 +74,7 @@ inline constexpr std::uint32_t kNone = ~std::uint32_t(0);  ///< background, unwa
 struct Config {
   int triangles = 0, vertices = 0;
   std::array<std::uint16_t, 12> vertex{};
-  std::array<std::array<std::uint8_t, 3>, CubeTriangulation::kMaxTriangles> corners{};
+  std::array<std::array<std::uint8_t, 3>, CubeTriangulation::kMaxTriangles> triangle{};
 };
 
 inline std::array<Config, 256> configTable(AdjacencyPair pair) {
@@ -95,7 +95,7 @@ inline std::array<Config, 256> configTable(AdjacencyPair pair) {
           indexOfEdge[edge] = c.vertices;
           c.vertex[std::size_t(c.vertices++)] = std::uint16_t((lowIsL ? low : high) | ((1u << n) - 1) << 3);
         }
-        c.corners[i][j] = std::uint8_t(indexOfEdge[edge]);
+        c.triangle[i][j] = std::uint8_t(indexOfEdge[edge]);
       }
   }
   return out;
@@ -404,7 +404,7 @@ class SlabScanner {
             std::array<std::uint32_t, 3>*& to = triangles_[L];
             __builtin_prefetch(to + 24, 1);  // the arrays were zeroed long ago: fetch ahead for writing
             for (int t = 0; t < entry.triangles; ++t) {
-              const auto& corners = entry.corners[std::size_t(t)];
+              const auto& corners = entry.triangle[std::size_t(t)];
               *to++ = {vertex[corners[0]], vertex[corners[1]], vertex[corners[2]]};
             }
           }
