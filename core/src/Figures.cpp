@@ -2,6 +2,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "Extract.h"
 #include "MeshComponents.h"
@@ -22,15 +25,45 @@ std::vector<ComponentFigures> componentFigures(const std::vector<Point>& vertice
   std::size_t count = 0;
   std::vector<std::uint32_t> label = triangleComponents(vertices.size(), triangles, count);
   std::vector<ComponentFigures> figures(count);
-  for (std::uint32_t c : label) ++figures[c].surfels;
-  for (const auto& t : triangles) {
-    ComponentFigures& f = figures[label[t[0]]];
-    ++f.triangles;
-    const Point& a = vertices[t[0]];
-    const Point n = refine::triangleNormal({a, vertices[t[1]], vertices[t[2]]});
-    f.area += 0.5 * std::sqrt(dot(n, n));
-    // Divergence theorem: the signed volume of the tetrahedron (0, a, b, c), summed.
-    f.volume += dot(a, cross(vertices[t[1]], vertices[t[2]])) / 6.0;
+  // Twice the area: |(b - a) x (c - a)|. Divergence theorem: the signed volume of the
+  // tetrahedron (0, a, b, c), summed.
+  auto squaredNormal = [&](const std::array<std::uint32_t, 3>& t) {
+    const Point n = refine::triangleNormal({vertices[t[0]], vertices[t[1]], vertices[t[2]]});
+    return dot(n, n);
+  };
+  auto tetrahedron = [&](const std::array<std::uint32_t, 3>& t) {
+    return dot(vertices[t[0]], cross(vertices[t[1]], vertices[t[2]])) / 6.0;
+  };
+  auto add = [&](const std::array<std::uint32_t, 3>& t, double& area, double& volume) {
+    area += 0.5 * std::sqrt(squaredNormal(t));
+    volume += tetrahedron(t);
+  };
+  if (count == 1) {  // one boundary, the most frequent case: the sums in registers, same order
+    ComponentFigures& f = figures[0];
+    f.surfels = vertices.size();
+    f.triangles = triangles.size();
+    double area = 0, volume = 0;
+    std::size_t i = 0;
+#if defined(__SSE2__)
+    for (; i + 2 <= triangles.size(); i += 2) {  // two square roots at once (correctly rounded both)
+      double root[2];
+      _mm_storeu_pd(root, _mm_sqrt_pd(_mm_set_pd(squaredNormal(triangles[i + 1]), squaredNormal(triangles[i]))));
+      area += 0.5 * root[0];
+      volume += tetrahedron(triangles[i]);
+      area += 0.5 * root[1];
+      volume += tetrahedron(triangles[i + 1]);
+    }
+#endif
+    for (; i < triangles.size(); ++i) add(triangles[i], area, volume);
+    f.area = area;
+    f.volume = volume;
+  } else {
+    for (std::uint32_t c : label) ++figures[c].surfels;
+    for (const auto& t : triangles) {
+      ComponentFigures& f = figures[label[t[0]]];
+      ++f.triangles;
+      add(t, f.area, f.volume);
+    }
   }
   for (ComponentFigures& f : figures) {
     f.edges = 3 * f.triangles / 2;  // a closed surface: every edge borders two triangles

@@ -1,7 +1,9 @@
-// extractLabels (docs/api.md, "Label maps"): one scan for every label's seeds
-// (tracker/LabelSeeds.h), then, labels in parallel, each label's boundaries tracked
-// (tracker/TrackBoundaries.h), converted (converter/LoopExtraction.h) and placed by the
-// midpoint mapping (paper §3.1) like extract()'s.
+// extractLabels (docs/api.md, "Label maps"). Every boundary: one scan of the cubes for all the
+// labels (converter/ScanLabels.h), which writes each label's mesh, placed by the midpoint
+// mapping (paper §3.1), straight into its Surface. Some boundaries: one scan for every label's
+// seeds (tracker/LabelSeeds.h), then, labels in parallel, each label's boundaries tracked
+// (tracker/TrackBoundaries.h), converted (converter/LoopExtraction.h) and placed like
+// extract()'s.
 #include "Labels.h"
 
 #include <algorithm>
@@ -10,11 +12,13 @@
 #include <optional>
 #include <sstream>
 #include <type_traits>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "BoundaryMapping.h"
 #include "FindSeed.h"
 #include "Image.h"
 #include "LabelSeeds.h"
@@ -179,9 +183,9 @@ void requireExactLabels(const std::vector<T>& labels) {
         throw InvalidInput("label " + std::to_string(L) + " is beyond 2^53: labels must be exact as doubles");
 }
 
-/// The fields of a label's result that do not depend on how its mesh was made.
-LabelSurface labelSurface(const VoxelSource& source, double label, std::uint64_t voxels, TriangleMesh&& mesh,
-                          const LabelOptions& o) {
+/// The fields of a label's result that do not depend on how its mesh was made (but the
+/// vertices, triangles and surfels).
+LabelSurface labelFields(double label, std::uint64_t voxels, const LabelOptions& o) {
   LabelSurface result;
   result.label = label;
   result.voxels = voxels;
@@ -189,35 +193,66 @@ LabelSurface labelSurface(const VoxelSource& source, double label, std::uint64_t
   s.pair = o.pair;
   s.selection = Selection::label(label);
   s.mapping = Mapping::Midpoint;
+  return result;
+}
+
+/// A label's result from its converted mesh, placed by the midpoint mapping.
+LabelSurface labelSurface(const VoxelSource& source, double label, std::uint64_t voxels, TriangleMesh&& mesh,
+                          const LabelOptions& o) {
+  LabelSurface result = labelFields(label, voxels, o);
+  Surface& s = result.surface;
   placeSurface(source, std::move(mesh), Mapping::Midpoint, s.selection, 0.25, s);
   if (o.figures) addFigures(s);
   return result;
 }
 
-/// Every boundary of the selected labels: one scan of the cubes converts them all
-/// (ScanLabels.h), then each label's mesh is placed, labels in parallel.
+/// Every boundary of the selected labels: the count pass of one scan of the cubes
+/// (converter/ScanLabels.h) sizes each label's Surface, its fill pass writes the surfels, their
+/// points (the midpoint mapping, then the geometry, as placeSurface places them) and the
+/// triangles into it; then each label's figures, labels in parallel.
 template <class T>
 std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& source, const LabelOptions& o,
                                   tbb::task_arena& arena, int parts) {
   if (o.labels.kind == LabelSelection::Kind::List) requireListable<T>(o.labels, o.background);
   if (o.labels.kind == LabelSelection::Kind::Range) requireNonEmptyRange(o.labels);
   const WantedLabel<T> wanted(o.labels);
-  LabelScan<T> scan = scanLabelSurfaces(image, T(o.background), wanted, o.pair, arena, parts);
+  LabelSurfaceScan<T, WantedLabel<T>> scan(image, T(o.background), wanted, o.pair, arena, parts);
+  const LabelCounts<T>& counts = scan.counts();
 
-  requireExactLabels(scan.labels);
-  const std::vector<std::size_t> selected = selectLabels(scan.labels, o.labels, o.background);
-  // Largest first, so that the last to finish are small.
-  std::vector<std::size_t> order(selected.size());
-  std::iota(order.begin(), order.end(), std::size_t(0));
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return scan.meshes[selected[a]].surfels.size() > scan.meshes[selected[b]].surfels.size();
-  });
-  std::vector<LabelSurface> out(selected.size());
-  forEachIndex(arena, order.size(), [&](std::size_t k) {
+  requireExactLabels(counts.labels);
+  const std::vector<std::size_t> selected = selectLabels(counts.labels, o.labels, o.background);
+  // The scan kept the wanted labels only, and selectLabels checked that each listed one occurs.
+  if (selected.size() != counts.labels.size()) throw InternalError("the label scan kept labels not selected");
+  const std::size_t n = counts.labels.size();
+  auto cancelled = [&] {
     if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
-    const std::size_t r = order[k], i = selected[r];
-    out[r] = labelSurface(source, double(scan.labels[i]), scan.voxels[i], std::move(scan.meshes[i]), o);
-    Surface& s = out[r].surface;
+  };
+  std::vector<LabelSurface> out(n);
+  std::vector<LabelMeshArrays> arrays(n);
+  forEachIndex(arena, n, [&](std::size_t i) {
+    out[i] = labelFields(double(counts.labels[i]), counts.voxels[i], o);
+    Surface& s = out[i].surface;
+    s.vertices.resize(counts.surfels[i]);
+    s.surfels.resize(counts.surfels[i]);
+    s.triangles.resize(counts.triangles[i]);
+    arrays[i] = {s.surfels.data(), s.vertices.data(), s.triangles.data()};
+  });
+  cancelled();
+  const ImageGeometry geometry = source.geometry();
+  scan.fill(arrays, [&](const Surfel& s) { return geometry.toPhysical(MidpointMapping{}(s)); });
+  const bool mirrored = geometry.handedness() < 0;  // keep the normals pointing outwards (placeSurface)
+
+  // Largest first, so that the last to finish are small.
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return counts.surfels[a] > counts.surfels[b]; });
+  forEachIndex(arena, n, [&](std::size_t k) {
+    cancelled();
+    Surface& s = out[order[k]].surface;
+    if (mirrored)
+      for (auto& t : s.triangles) std::swap(t[1], t[2]);
+    if (o.figures) addFigures(s);
     std::size_t boundaries = s.components.size();
     if (!o.figures) triangleComponents(s.vertices.size(), s.triangles, boundaries);
     s.boundariesInImage = boundaries;
