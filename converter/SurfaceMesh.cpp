@@ -286,8 +286,9 @@ FreshArray<std::uint32_t> pairDirectedEdges(const std::vector<std::array<std::ui
   {
     constexpr std::uint32_t kShort = 16, kNone = ~std::uint32_t(0);
     alignas(16) std::uint32_t a[kShort], b[kShort], follower[kShort + 1];
-    std::uint32_t out[kShort + 1], in[kShort];
-    follower[kShort] = kShort, out[kShort] = std::uint32_t(H);  // the dead end writes link[H]
+    std::uint32_t out[kShort + 1], in[kShort + 1];
+    // The dead end writes link[H] (and reads its own in[] slot, as shortFan's does).
+    follower[kShort] = kShort, out[kShort] = in[kShort] = std::uint32_t(H);
     std::vector<std::uint32_t> longA, longB, longOut, longIn, longFollower;
     static_assert(sizeof(T[0]) == 3 * sizeof(std::uint32_t));
     const std::uint32_t* const vertexAt = T.empty() ? nullptr : T[0].data();
@@ -361,7 +362,7 @@ FreshArray<std::uint32_t> pairDirectedEdges(const std::vector<std::array<std::ui
           longIn[i] = 3 * f + kPrevCorner[j];
           if (longA[i] == u) degenerate(T, std::uint32_t(u), c, d);
         }
-        longOut.push_back(std::uint32_t(H));
+        longOut.push_back(std::uint32_t(H)), longIn.push_back(std::uint32_t(H));
         longFanFollowers(longA, longB, longFollower);
         fol = longFollower.data(), po = longOut.data(), pi = longIn.data();
       }

@@ -1,42 +1,56 @@
 #!/usr/bin/env bash
-# The checks CI runs after the README's test command (.ci/run):
-#   1. the whole test suite again, in a build of its own with AddressSanitizer and
-#      UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its test);
-#   2. the libFuzzer targets of fuzz/ (the header readers that locate voxel data), each for a
-#      bounded time, seeded with the test files (fuzz/run_fuzzers.sh).
+# The checks beyond the README's test command:
+#   fuzz [seconds]  the libFuzzer target of fuzz/ (the header readers that locate voxel data),
+#                   run per format for a bounded time, seeded with the test files
+#                   (fuzz/run_fuzzers.sh; default 10 s per format). CI runs this (.ci/run).
+#   sanitize        the whole test suite again, in a build of its own with AddressSanitizer and
+#                   UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its
+#                   test). About 22 minutes on the 2-core machines: not in CI (README, "Status").
+#   all [seconds]   both.
 #
-#   scripts/ci-checks.sh [seconds per fuzz target, default 20]
+#   scripts/ci-checks.sh fuzz|sanitize|all [seconds per fuzz target]
 #
 # Needs what scripts/setup.sh installs, plus clang for the fuzzers (installed here when missing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds=${1:-20}
+mode=${1:-all}
+seconds=${2:-10}
 here=$PWD
+case $mode in
+  fuzz | sanitize | all) ;;
+  *) echo "usage: scripts/ci-checks.sh fuzz|sanitize|all [seconds per fuzz target]" >&2; exit 2 ;;
+esac
 
-if ! command -v clang++ >/dev/null; then
-  sudo=""
-  [[ $(id -u) -eq 0 ]] || sudo="sudo"
-  echo "ci-checks: installing clang (the fuzzers)" >&2
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq clang >/dev/null
-fi
+sanitize() {
+  local start built
+  start=$(date +%s)
+  # -O1: instrumented code at -O3 compiles about 4x slower (one test file: 765 s against 177 s
+  # at -O1) for tests that run about 2x faster; stacks name functions (frame pointers kept), not
+  # lines. No benchmarks (nor the CGAL tool they use).
+  cmake -S . -B build-sanitize -DSURFTRACK_SANITIZE=ON -DSURFTRACK_BUILD_BENCH=OFF \
+        -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" >/dev/null
+  cmake --build build-sanitize -j2 >build-sanitize.log 2>&1 || { tail -60 build-sanitize.log; exit 1; }
+  built=$(date +%s)
+  echo "ci-checks: sanitized build in $((built - start)) s"
+  # Leaks inside third-party readers on their error paths are theirs (tests/lsan.supp names
+  # each); every other leak, and every ASan or UBSan report, fails the test that caused it.
+  ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1" \
+  LSAN_OPTIONS="suppressions=$here/tests/lsan.supp:print_suppressions=0" \
+  UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+    ctest --test-dir build-sanitize --output-on-failure -j2
+  echo "ci-checks: sanitized test suite in $(($(date +%s) - built)) s"
+}
 
-start=$(date +%s)
-# -O1: instrumented code at -O3 compiles about 4x slower (one test file: 765 s against 177 s
-# at -O1) for tests that run about 2x faster; stacks name functions (frame pointers kept), not
-# lines. No benchmarks (nor the CGAL tool they use).
-cmake -S . -B build-sanitize -DSURFTRACK_SANITIZE=ON -DSURFTRACK_BUILD_BENCH=OFF \
-      -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" >/dev/null
-cmake --build build-sanitize -j2 >build-sanitize.log 2>&1 || { tail -60 build-sanitize.log; exit 1; }
-built=$(date +%s)
-echo "ci-checks: sanitized build in $((built - start)) s"
-# Leaks inside third-party readers on their error paths are theirs (tests/lsan.supp names each);
-# every other leak, and every ASan or UBSan report, fails the test that caused it.
-ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1" \
-LSAN_OPTIONS="suppressions=$here/tests/lsan.supp:print_suppressions=0" \
-UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-  ctest --test-dir build-sanitize --output-on-failure -j2
-echo "ci-checks: sanitized test suite in $(($(date +%s) - built)) s"
+fuzz() {
+  if ! command -v clang++ >/dev/null; then
+    local sudo=""
+    [[ $(id -u) -eq 0 ]] || sudo="sudo"
+    echo "ci-checks: installing clang (the fuzzers)" >&2
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq clang >/dev/null
+  fi
+  bash fuzz/run_fuzzers.sh "$seconds" "$here/build-fuzz"
+}
 
-bash fuzz/run_fuzzers.sh "$seconds" "$here/build-fuzz"
-echo "ci-checks: $(($(date +%s) - start)) s in all"
+[[ $mode == fuzz ]] || sanitize
+[[ $mode == sanitize ]] || fuzz
