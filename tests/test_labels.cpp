@@ -19,6 +19,7 @@
 #include "CaseSubset.h"
 #include "Extract.h"
 #include "Labels.h"
+#include "Refine.h"
 #include "MeshChecks.h"
 #include "PairTestName.h"
 #include "ReadVolume.h"
@@ -492,6 +493,48 @@ TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
       EXPECT_EQ(got, std::vector<std::uint64_t>(expected.begin(), expected.end())) << "label " << ls.label;
     }
   }
+}
+
+// A label's Surface carries its image's geometry, as extract()'s does, so that smoothing keeps
+// each vertex on its surfel's segment ]c, d[ in physical space (docs/theory.md, smoothing);
+// here 2 x 0.5 x 1.5 mm voxels in a mirrored frame, every segment computed again from c and d.
+TEST(Labels, SmoothingKeepsEveryVertexOnItsSegmentInPhysicalSpace) {
+  std::int64_t background = 0;
+  std::string shape;
+  const LabelVolume volume = randomLabels(11, background, shape);
+  const std::vector<std::int32_t> data = typed<std::int32_t>(volume);
+  ImageGeometry g;
+  g.spacing = {2.0, 0.5, 1.5};
+  g.origin = {-10, 4, 7};
+  g.direction = {{{0, 1, 0}, {1, 0, 0}, {0, 0, 1}}};
+  LabelOptions options;
+  options.background = double(background);
+  std::vector<LabelSurface> surfaces = extractLabels(VolumeView::of(data.data(), volume.dims, g), options);
+  ASSERT_FALSE(surfaces.empty()) << shape;
+  std::size_t moved = 0, vertices = 0;
+  for (LabelSurface& ls : surfaces) {
+    Surface& s = ls.surface;
+    const std::vector<std::array<double, 3>> before = s.vertices;
+    smooth(s);
+    for (std::size_t v = 0; v < s.vertices.size(); ++v) {
+      const Voxel c = s.surfels[v].inside(), d = s.surfels[v].outside();
+      const auto p = g.toPhysical({double(c.x), double(c.y), double(c.z)});
+      const auto q = g.toPhysical({double(d.x), double(d.y), double(d.z)});
+      const auto& x = s.vertices[v];
+      double along = 0, length2 = 0;
+      for (int i = 0; i < 3; ++i) along += (x[i] - p[i]) * (q[i] - p[i]), length2 += (q[i] - p[i]) * (q[i] - p[i]);
+      const double t = along / length2;
+      double off = 0;
+      for (int i = 0; i < 3; ++i) off = std::max(off, std::abs(x[i] - p[i] - t * (q[i] - p[i])));
+      EXPECT_GT(t, 0.0) << "label " << ls.label << " vertex " << v;
+      EXPECT_LT(t, 1.0) << "label " << ls.label << " vertex " << v;
+      EXPECT_LT(off, 1e-9) << "label " << ls.label << " vertex " << v << " is off its segment";
+      moved += x != before[v];
+      ++vertices;
+      if (HasFailure()) return;
+    }
+  }
+  EXPECT_GT(moved, vertices / 4) << "smoothing moved the vertices";
 }
 
 TEST(Labels, TheSurfacesAreTheSameForAnyNumberOfThreads) {

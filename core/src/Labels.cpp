@@ -185,11 +185,12 @@ void requireExactLabels(const std::vector<T>& labels) {
 
 /// The fields of a label's result that do not depend on how its mesh was made (but the
 /// vertices, triangles and surfels).
-LabelSurface labelFields(double label, std::uint64_t voxels, const LabelOptions& o) {
+LabelSurface labelFields(const VoxelSource& source, double label, std::uint64_t voxels, const LabelOptions& o) {
   LabelSurface result;
   result.label = label;
   result.voxels = voxels;
   Surface& s = result.surface;
+  s.geometry = source.geometry();  // the segments smoothing keeps each vertex on (Refine.h)
   s.pair = o.pair;
   s.selection = Selection::label(label);
   s.mapping = Mapping::Midpoint;
@@ -199,7 +200,7 @@ LabelSurface labelFields(double label, std::uint64_t voxels, const LabelOptions&
 /// A label's result from its converted mesh, placed by the midpoint mapping.
 LabelSurface labelSurface(const VoxelSource& source, double label, std::uint64_t voxels, TriangleMesh&& mesh,
                           const LabelOptions& o) {
-  LabelSurface result = labelFields(label, voxels, o);
+  LabelSurface result = labelFields(source, label, voxels, o);
   Surface& s = result.surface;
   placeSurface(source, std::move(mesh), Mapping::Midpoint, s.selection, 0.25, s);
   if (o.figures) addFigures(s);
@@ -230,7 +231,7 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   std::vector<LabelSurface> out(n);
   std::vector<LabelMeshArrays> arrays(n);
   forEachIndex(arena, n, [&](std::size_t i) {
-    out[i] = labelFields(double(counts.labels[i]), counts.voxels[i], o);
+    out[i] = labelFields(source, double(counts.labels[i]), counts.voxels[i], o);
     Surface& s = out[i].surface;
     s.vertices.resize(counts.surfels[i]);
     s.surfels.resize(counts.surfels[i]);
