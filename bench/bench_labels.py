@@ -12,7 +12,7 @@
     cached in --cache): every label, all boundaries, on N threads, in a fresh
     process so that its peak resident memory (ru_maxrss) is that of loading the volume and
     extracting, compared with 2 x the volume + the output (the C++ surfaces: 24 bytes a vertex,
-    8 a surfel, 12 a triangle). Then, in another fresh process of the same run,
+    16 a surfel (sizeof(Surfel)), 12 a triangle). Then, in another fresh process of the same run,
     vtkDiscreteFlyingEdges3D on the same threads with the first --vtk-labels label values only
     (it makes one pass over the volume per value: all 2,500 would take hours); its time for all
     the labels is that time x cells / --vtk-labels, an extrapolation, printed as such.
@@ -193,7 +193,7 @@ def part_voronoi(args) -> None:
                          capture_output=True, text=True, check=True, env=os.environ)
     r = json.loads(run.stdout.strip().splitlines()[-1])
     assert r["labels"] == args.cells, r
-    output = 24 * r["vertices"] + 8 * r["vertices"] + 12 * r["faces"]
+    output = 24 * r["vertices"] + 16 * r["vertices"] + 12 * r["faces"]
     t = statistics.median(r["times"])
     limit = 2 * r["volume_bytes"] + output
     mib = 1 << 20

@@ -1,41 +1,30 @@
 #include "MeshComponents.h"
 
+#include <boost/pending/disjoint_sets.hpp>
+
 namespace surftrack {
 
 std::vector<std::uint32_t> triangleComponents(std::size_t vertexCount,
                                               const std::vector<std::array<std::uint32_t, 3>>& triangles,
                                               std::size_t& count) {
-  // Disjoint sets linked by the smaller root, with path halving: parent[v] <= v always, and a
-  // set's root is its smallest vertex.
-  std::vector<std::uint32_t> parent(vertexCount);
-  for (std::uint32_t v = 0; v < vertexCount; ++v) parent[v] = v;
-  std::uint32_t* p = parent.data();
-  auto find = [p](std::uint32_t v) {
-    while (p[v] != v) {
-      p[v] = p[p[v]];
-      v = p[v];
-    }
-    return v;
-  };
-  auto link = [p](std::uint32_t a, std::uint32_t b) {  // two roots; the smaller one stays
-    if (a < b) {
-      p[b] = a;
-      return a;
-    }
-    p[a] = b;
-    return b;
-  };
+  std::vector<std::uint32_t> rank(vertexCount), parent(vertexCount);
+  boost::disjoint_sets<std::uint32_t*, std::uint32_t*> sets(rank.data(), parent.data());
+  for (std::uint32_t v = 0; v < vertexCount; ++v) sets.make_set(v);
   for (const auto& t : triangles) {
-    const std::uint32_t a = find(t[0]), b = find(t[1]);
-    const std::uint32_t r = a == b ? a : link(a, b);
-    const std::uint32_t c = find(t[2]);
-    if (c != r) link(r, c);
+    sets.union_set(t[0], t[1]);
+    sets.union_set(t[0], t[2]);
   }
-  // Numbers in the order of the smallest vertices, in place: when v is reached, parent[v] = u
-  // <= v is v itself (a root, a new number) or a vertex of the same set already numbered.
+  // A set's number is given at its first (smallest) vertex; `rank` is reused for it.
+  constexpr std::uint32_t kUnnumbered = ~std::uint32_t(0);
+  std::fill(rank.begin(), rank.end(), kUnnumbered);
+  std::vector<std::uint32_t> label(vertexCount);
   count = 0;
-  for (std::uint32_t v = 0; v < vertexCount; ++v) p[v] = p[v] == v ? std::uint32_t(count++) : p[p[v]];
-  return parent;
+  for (std::uint32_t v = 0; v < vertexCount; ++v) {
+    std::uint32_t& number = rank[sets.find_set(v)];
+    if (number == kUnnumbered) number = std::uint32_t(count++);
+    label[v] = number;
+  }
+  return label;
 }
 
 }  // namespace surftrack

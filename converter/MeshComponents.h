@@ -1,5 +1,5 @@
-// Connected components of a triangle mesh through shared vertices, by disjoint sets (union by
-// the smaller root, path halving). On the mesh of a whole image (the scanning method) the
+// Connected components of a triangle mesh through shared vertices, with Boost's disjoint sets:
+// the one union-find of the project. On the mesh of a whole image (the scanning method) the
 // components are exactly the kappa-lambda-boundaries (Proposition 39).
 #pragma once
 
