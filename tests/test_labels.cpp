@@ -19,10 +19,10 @@
 #include "CaseSubset.h"
 #include "Extract.h"
 #include "Labels.h"
-#include "Refine.h"
 #include "MeshChecks.h"
 #include "PairTestName.h"
 #include "ReadVolume.h"
+#include "Refine.h"
 
 using namespace surftrack;
 namespace ref = surftrack::testing;
@@ -496,7 +496,7 @@ TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
 }
 
 // A label's Surface carries its image's geometry, as extract()'s does, so that smoothing keeps
-// each vertex on its surfel's segment ]c, d[ in physical space (docs/theory.md, smoothing);
+// each vertex on its surfel's segment ]c, d[ in physical space (docs/theory.md §8);
 // here 2 x 0.5 x 1.5 mm voxels in a mirrored frame, every segment computed again from c and d.
 TEST(Labels, SmoothingKeepsEveryVertexOnItsSegmentInPhysicalSpace) {
   std::int64_t background = 0;
