@@ -5,7 +5,7 @@
 #                   (fuzz/run_fuzzers.sh; default 10 s per format). CI runs this (.ci/run).
 #   sanitize        the whole test suite again, in a build of its own with AddressSanitizer and
 #                   UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its
-#                   test). About 22 minutes on the 2-core machines: not in CI (README, "Status").
+#                   test). About 24 minutes on the 2-core machines (16 of build, 7.5 of tests): not in CI.
 #   all [seconds]   both.
 #
 #   scripts/ci-checks.sh fuzz|sanitize|all [seconds per fuzz target]
