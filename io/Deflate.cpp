@@ -1,23 +1,37 @@
-// zlib's inflate over a byte range of a file, the output discarded.
+// zlib's inflate over a byte range of a file, the output discarded or the first bytes kept;
+// libdeflate's one-call gzip decoder for a whole file.
 #include "Deflate.h"
 
+#include <libdeflate.h>
 #include <zlib.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <new>
 #include <string>
 #include <vector>
 
+#include "HugePages.h"
 #include "ReadVolume.h"
 
 namespace surftrack::io::detail {
 
+namespace {
+
+[[noreturn]] void corrupt(const OpenFile& file, const std::string& why) {
+  throw ReadError(file.context() + ": corrupt compressed data (" + why + ")");
+}
+
+std::string zlibError(const z_stream& z, int status) {
+  return z.msg ? z.msg : "zlib error " + std::to_string(status);
+}
+
+}  // namespace
+
 void requireDeflated(const OpenFile& file, std::uint64_t offset, std::uint64_t length, std::uint64_t expected) {
-  auto fail = [&](const std::string& why) {
-    throw ReadError(file.context() + ": corrupt compressed data (" + why + ")");
-  };
-  if (offset > file.size() || file.size() - offset < length) fail("the stream runs past the end of the file");
+  if (offset > file.size() || file.size() - offset < length) corrupt(file, "the stream runs past the end of the file");
   z_stream z{};
-  if (inflateInit2(&z, 47) != Z_OK) fail("zlib cannot start");
+  if (inflateInit2(&z, 47) != Z_OK) corrupt(file, "zlib cannot start");
   constexpr std::size_t kChunk = std::size_t(1) << 20;
   std::vector<unsigned char> in(kChunk), out(kChunk);
   std::uint64_t read = 0, inflated = 0;
@@ -36,15 +50,110 @@ void requireDeflated(const OpenFile& file, std::uint64_t offset, std::uint64_t l
     status = inflate(&z, Z_NO_FLUSH);
     inflated += out.size() - z.avail_out;
     if (status != Z_OK && status != Z_STREAM_END && !(status == Z_BUF_ERROR && z.avail_in == 0)) {
-      const std::string why = z.msg ? z.msg : "zlib error " + std::to_string(status);
+      const std::string why = zlibError(z, status);
       inflateEnd(&z);
-      fail(why);
+      corrupt(file, why);
     }
   }
   inflateEnd(&z);
   if (inflated < expected)
-    fail("it inflates to " + std::to_string(inflated) + " bytes, fewer than the " + std::to_string(expected) +
-         " bytes of voxels (truncated file?)");
+    corrupt(file, "it inflates to " + std::to_string(inflated) + " bytes, fewer than the " + std::to_string(expected) +
+                      " bytes of voxels (truncated file?)");
+}
+
+bool isGzip(const OpenFile& file) {
+  const std::string magic = file.head(2);
+  return magic.size() == 2 && static_cast<unsigned char>(magic[0]) == 0x1f && static_cast<unsigned char>(magic[1]) == 0x8b;
+}
+
+std::size_t inflateGzipPrefix(const OpenFile& file, unsigned char* out, std::size_t bytes, bool checkRest) {
+  z_stream z{};
+  if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK) corrupt(file, "zlib cannot start");
+  std::vector<unsigned char> in(std::size_t(1) << 16), scratch;
+  std::uint64_t read = 0;
+  std::size_t made = 0;
+  bool ended = false;  // the last member read to its end
+  for (;;) {
+    const bool discarding = made == bytes;  // the bytes after the first `bytes`, if checkRest
+    if (discarding) {
+      if (!checkRest) break;
+      scratch.resize(std::size_t(1) << 16);
+      z.next_out = scratch.data();
+      z.avail_out = uInt(scratch.size());
+    } else {
+      z.next_out = out + made;
+      z.avail_out = uInt(std::min<std::size_t>(bytes - made, std::size_t(1) << 30));
+    }
+    if (z.avail_in == 0) {
+      const std::size_t n = file.readAt(read, in.data(), in.size());
+      if (n == 0) break;  // the file ends
+      read += n;
+      z.next_in = in.data();
+      z.avail_in = uInt(n);
+    }
+    const uInt room = z.avail_out;
+    const int status = inflate(&z, Z_NO_FLUSH);
+    if (!discarding) made += room - z.avail_out;
+    ended = status == Z_STREAM_END;
+    if (ended) {
+      // Another member follows, or bytes that gzread ignores.
+      unsigned char magic[2] = {0, 0};
+      if (file.readAt(read - z.avail_in, magic, 2) < 2 || magic[0] != 0x1f || magic[1] != 0x8b) break;
+      inflateReset(&z);
+    } else if (status != Z_OK && !(status == Z_BUF_ERROR && z.avail_in == 0)) {
+      const std::string why = zlibError(z, status);
+      inflateEnd(&z);
+      corrupt(file, why);
+    }
+  }
+  inflateEnd(&z);
+  if (checkRest && !ended) corrupt(file, "the gzip stream is cut short (truncated file?)");
+  return made;
+}
+
+Inflated inflateGzip(const OpenFile& file, std::uint64_t bytes, std::uint64_t alignedAt) {
+  if (bytes > std::uint64_t(SIZE_MAX) / 2) throw std::bad_alloc();
+  // The compressed bytes mapped (read if the system refuses), the output on fresh 2 MiB pages:
+  // it is written once, front to back.
+  std::string why;
+  std::shared_ptr<const void> in = file.map(0, file.size(), why);
+  if (!in) in = file.read(0, file.size());
+  constexpr std::size_t kHuge = std::size_t(1) << 21;
+  const std::size_t pad = std::size_t((64 - alignedAt % 64) % 64);
+  const std::size_t total = std::size_t(bytes) + pad;
+  const std::size_t rounded = (std::max<std::size_t>(total, 1) + kHuge - 1) & ~(kHuge - 1);
+  void* p = std::aligned_alloc(kHuge, rounded);
+  if (!p) throw std::bad_alloc();
+  Inflated out{std::shared_ptr<void>(p, [](void* q) { std::free(q); }), static_cast<unsigned char*>(p) + pad};
+  adviseHugePages(p, rounded);
+
+  const std::unique_ptr<libdeflate_decompressor, void (*)(libdeflate_decompressor*)> decoder(
+      libdeflate_alloc_decompressor(), libdeflate_free_decompressor);
+  if (!decoder) throw std::bad_alloc();
+  const auto* next = static_cast<const unsigned char*>(in.get());
+  std::size_t left = std::size_t(file.size()), done = 0;
+  // Member after member until the output is full; what follows is ignored, as gzread does.
+  while (done < bytes && left >= 2 && next[0] == 0x1f && next[1] == 0x8b) {
+    std::size_t used = 0, made = 0;
+    const libdeflate_result r = libdeflate_gzip_decompress_ex(decoder.get(), next, left, out.data + done,
+                                                              std::size_t(bytes) - done, &used, &made);
+    if (r == LIBDEFLATE_INSUFFICIENT_SPACE) {
+      // The members hold more than `bytes` (or a damaged one seems to): gzread would read the
+      // first `bytes` and stop, and so does zlib here.
+      done = inflateGzipPrefix(file, out.data, std::size_t(bytes), /*checkRest=*/true);
+      break;
+    }
+    if (r != LIBDEFLATE_SUCCESS)
+      corrupt(file, "the gzip stream" + (done > 0 ? " after byte " + std::to_string(file.size() - left) : std::string()) +
+                        " is damaged or cut short (truncated file?)");
+    done += made;
+    next += used;
+    left -= used;
+  }
+  if (done < bytes)
+    corrupt(file, "it inflates to " + std::to_string(done) + " bytes, fewer than the " + std::to_string(bytes) +
+                      " its header announces (truncated file?)");
+  return out;
 }
 
 }  // namespace surftrack::io::detail

@@ -164,6 +164,70 @@ std::string dimsText(Dims d) {
   return std::to_string(d.nx) + "x" + std::to_string(d.ny) + "x" + std::to_string(d.nz);
 }
 
+/// What ITK reads differently from the parser's layout (empty if nothing): the voxels are then
+/// ITK's to decode.
+std::string disagreement(const detail::ItkHeader& itk, const DataLayout& layout) {
+  if (itk.type != layout.type) return "ITK reads its voxels as " + toString(itk.type) + ", not " + toString(layout.type);
+  if (itk.dims != layout.dims)
+    return "ITK reads it as " + dimsText(itk.dims) + " voxels, not " + dimsText(layout.dims);
+  if (sizeOf(layout.type) > 1 && itk.byteOrder == detail::ItkHeader::ByteOrder::Big)
+    return "ITK reads its voxels as big-endian";
+  return {};
+}
+
+constexpr std::string_view kGzippedNifti = ".nii.gz";
+
+bool isGzippedNifti(const std::string& path) {
+  std::string name = fs::path(path).filename().string();
+  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return name.size() >= kGzippedNifti.size() &&
+         name.compare(name.size() - kGzippedNifti.size(), kGzippedNifti.size(), kGzippedNifti) == 0;
+}
+
+/// A gzip'd single-file NIfTI-1 image: its header inflated and parsed first (the strict parser
+/// of a .nii, so that a malformed header is an error before ITK sees it), its geometry read by
+/// ITK as for a mapped file, then the whole file inflated once, by libdeflate, into the buffer
+/// the view reads (Deflate.h): no second copy. What the parser or ITK would decode otherwise
+/// (scaled or big-endian voxels, NIfTI-2, non-finite floats, ...) goes to ITK, as before.
+LoadedVolume loadGzippedNifti(const std::string& path) {
+  const std::string name = "nii.gz";
+  const detail::OpenFile file(path, "cannot read " + quoted(path));
+  if (file.size() == 0) throw ReadError("cannot read " + quoted(path) + ": the file is empty");
+  if (!detail::isGzip(file))  // (ITK would read it as a .nii, unchecked: niftilib's gzread reads plain files too)
+    throw ReadError("cannot read " + quoted(path) + ": it is not gzip-compressed, as a .nii.gz file must be");
+  std::string head(4096, '\0');
+  head.resize(detail::inflateGzipPrefix(file, reinterpret_cast<unsigned char*>(head.data()), head.size(), false));
+  DataLayout layout;
+  try {
+    // The inflated size is known here only if it is short; inflateGzip checks it otherwise.
+    const std::optional<DataLayout> parsed = parseNifti1Header(head, head.size() < 4096 ? head.size() : UINT64_MAX);
+    if (!parsed)
+      throw HeaderError("its compressed data ends inside the NIfTI-1 header (truncated file?)");
+    layout = *parsed;
+    if (layout.decodeReason.empty()) text::requireStored(layout.offset + layout.dataBytes(), 1032, file.size());
+  } catch (const HeaderError& e) {
+    throw ReadError("cannot read " + quoted(path) + ": " + e.what());
+  }
+  if (!layout.decodeReason.empty()) return decodedByItk(path, name, layout.decodeReason);
+  if (std::endian::native != std::endian::little && sizeOf(layout.type) > 1)
+    return decodedByItk(path, name, "its voxels are little-endian, this machine is not");
+  // Inflated before ITK reads the header, so that damage is reported as such.
+  const detail::Inflated inflated = detail::inflateGzip(file, layout.offset + layout.dataBytes(), layout.offset);
+  const detail::ItkHeader itk = detail::readItkHeader(path);
+  if (std::string why = disagreement(itk, layout); !why.empty()) return decodedByItk(path, name, why);
+  LoadedVolume out;
+  out.format = name;
+  out.dataBytes = layout.dataBytes();
+  out.decodeReason = "it is gzip-compressed (inflated into memory)";
+  out.owner = std::shared_ptr<const void>(inflated.owner, inflated.data + layout.offset);
+  const Dims dims = layout.dims;
+  out.view = VolumeView{out.owner.get(), layout.type, dims,
+                        {1, std::ptrdiff_t(dims.nx), std::ptrdiff_t(dims.nx) * dims.ny}, itk.geometry};
+  if (layout.nonFiniteReadAsZero && hasNonFinite(out.view))
+    return decodedByItk(path, name, "its float voxels include NaN or infinite values, which NIfTI readers read as 0");
+  return out;
+}
+
 }  // namespace
 
 std::uintmax_t LoadedVolume::residentBytes() const {
@@ -177,6 +241,13 @@ void LoadedVolume::advise(Access access) const {
 LoadedVolume loadVolume(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read " + quoted(path) + ": no such file");
+  if (isGzippedNifti(path) && !fs::is_directory(path, ec)) {
+    try {
+      return loadGzippedNifti(path);
+    } catch (const std::bad_alloc&) {
+      throw ReadError("cannot read " + quoted(path) + ": out of memory");
+    }
+  }
   const Format* format = formatOf(path);
   if (!format || fs::is_directory(path, ec)) return decodedByItk(path, "", "");
   try {
@@ -234,14 +305,7 @@ LoadedVolume loadVolume(const std::string& path) {
 
     // The geometry, as readVolume reads it; map only if ITK sees the same voxels.
     const detail::ItkHeader itk = detail::readItkHeader(path);
-    std::string disagreement;
-    if (itk.type != layout.type)
-      disagreement = "ITK reads its voxels as " + toString(itk.type) + ", not " + toString(layout.type);
-    else if (itk.dims != layout.dims)
-      disagreement = "ITK reads it as " + dimsText(itk.dims) + " voxels, not " + dimsText(layout.dims);
-    else if (sizeOf(layout.type) > 1 && itk.byteOrder == detail::ItkHeader::ByteOrder::Big)
-      disagreement = "ITK reads its voxels as big-endian";
-    if (!disagreement.empty()) return decodedByItk(path, name, disagreement);
+    if (std::string why = disagreement(itk, layout); !why.empty()) return decodedByItk(path, name, why);
 
     LoadedVolume out = viewVoxels(data, offset, layout.type, layout.dims, itk.geometry, /*swap=*/false);
     out.format = name;

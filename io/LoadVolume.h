@@ -8,9 +8,11 @@
 // touches are read from the file when it touches them, and the kernel may drop them again
 // under memory pressure. (Voxels at a file offset that is not a multiple of their size — after
 // an .mha or .nrrd text header of odd length, say — cannot be viewed as the T* the engine reads:
-// they are read into one aligned buffer instead.) Any other volume (gzip'd .nii.gz, compressed NRRD or MetaImage,
-// big-endian multi-byte voxels, DICOM, TIFF, VTK, NIfTI-2, ...) is decoded once by ITK into
-// ITK's own buffer, which is viewed in place; byte-swapped raw files are read and swapped into
+// they are read into one aligned buffer instead.) A gzip'd NIfTI-1 image (.nii.gz) is inflated
+// once, by libdeflate, into the buffer that is viewed (its header parsed and its geometry read
+// as a .nii's). Any other volume (compressed NRRD or MetaImage, big-endian multi-byte voxels,
+// DICOM, TIFF, VTK, NIfTI-2, ...) is decoded once by ITK into ITK's own buffer, which is viewed
+// in place; byte-swapped raw files are read and swapped into
 // one buffer. In both cases the geometry and the voxel values are what readVolume gives for
 // the same file — which is why a float32/float64 .nii, whose NaN and infinite voxels ITK's
 // NIfTI reader (niftilib) reads as 0, is read through once when loaded, to look for them (and
@@ -65,7 +67,7 @@ struct LoadedVolume {
 
 /// Loads a volume, the format from the file name: .mha, .mhd, .nrrd, .nhdr and .nii are
 /// mapped when they can be (their headers read by this library's own strict parsers, their
-/// geometry by ITK), anything else ITK reads (see readVolume), including a directory holding
+/// geometry by ITK), .nii.gz inflated by libdeflate when it can be, anything else ITK reads (see readVolume), including a directory holding
 /// one DICOM series. Throws ReadError with one line naming the file: missing, unreadable,
 /// malformed header, a file shorter than its header announces ("truncated file?"), unsupported
 /// voxel type.

@@ -10,7 +10,8 @@ packages=(
   libcgal-dev                    # CGAL 5.5, header-only: the refine tests' independent checks (self-intersection, point-in-mesh, distance); never linked into the engine
   libgtest-dev                   # GoogleTest
   libinsighttoolkit5-dev         # ITK: NIfTI / NRRD / MetaImage / DICOM volumes for the CLI
-  libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip size checks)
+  libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip streams)
+  libdeflate-dev pkg-config      # io/: a .nii.gz inflated in one call
   libcli11-dev                   # CLI11: the command line
   nlohmann-json3-dev             # nlohmann-json: the CLI's JSON output
   libtbb-dev                     # oneTBB: the scanning method on every core
