@@ -237,6 +237,59 @@ TEST(FrontDoor, FiguresMirrorsAndSeeds) {
   EXPECT_EQ(extract(VolumeView::of(v.data(), d, g), o).surfels, s.surfels);
 }
 
+// A seeded (or the largest) boundary is one component by construction, and extract() runs no
+// union-find for its figures: checked here against the components found by a breadth-first
+// search over the triangles' vertices, and against componentFigures (which runs one), on random
+// images for every adjacency pair.
+TEST(FrontDoor, ATrackedBoundaryIsOneComponentWithTheFiguresOfAUnionFind) {
+  std::mt19937 rng(20261202);
+  std::size_t surfaces = 0;
+  for (int image = 0; image < 300; ++image) {
+    const Dims d{int(4 + rng() % 10), int(4 + rng() % 10), int(4 + rng() % 10)};
+    const unsigned density = 20 + rng() % 60;  // percent of 1-voxels
+    std::vector<std::uint8_t> v(d.count());
+    for (auto& x : v) x = std::uint8_t(rng() % 100 < density);
+    for (AdjacencyPair pair : {AdjacencyPair::k26_6, AdjacencyPair::k18_6, AdjacencyPair::k6_18, AdjacencyPair::k6_26}) {
+      ExtractOptions o;
+      o.selection = Selection::threshold(0.5);
+      o.pair = pair;
+      o.seed = image % 3 == 0 ? SeedRule::largest()
+                              : SeedRule::fromVoxel({int(rng() % d.nx), int(rng() % d.ny), int(rng() % d.nz)});
+      Surface s;
+      try {
+        s = extract(VolumeView::of(v.data(), d), o);
+      } catch (const InvalidInput&) {
+        continue;  // no 1-voxel, or every voxel one
+      }
+      SCOPED_TRACE("image " + std::to_string(image) + ", pair " + std::to_string(int(pair)));
+      // The vertices reached from vertex 0 through the triangles' edges.
+      std::vector<std::vector<std::uint32_t>> neighbours(s.vertices.size());
+      for (const auto& t : s.triangles)
+        for (int j = 0; j < 3; ++j) neighbours[t[j]].push_back(t[(j + 1) % 3]), neighbours[t[(j + 1) % 3]].push_back(t[j]);
+      std::vector<char> reached(s.vertices.size(), 0);
+      std::vector<std::uint32_t> queue = {0};
+      reached[0] = 1;
+      for (std::size_t i = 0; i < queue.size(); ++i)
+        for (std::uint32_t w : neighbours[queue[i]])
+          if (!reached[w]) reached[w] = 1, queue.push_back(w);
+      EXPECT_EQ(queue.size(), s.vertices.size());
+      const std::vector<ComponentFigures> found = componentFigures(s.vertices, s.triangles);
+      ASSERT_EQ(s.components.size(), 1u);
+      ASSERT_EQ(found.size(), 1u);
+      const ComponentFigures &a = s.components[0], &b = found[0];
+      EXPECT_EQ(a.surfels, b.surfels);
+      EXPECT_EQ(a.triangles, b.triangles);
+      EXPECT_EQ(a.edges, b.edges);
+      EXPECT_EQ(a.euler, b.euler);
+      EXPECT_EQ(a.area, b.area);
+      EXPECT_EQ(a.volume, b.volume);
+      EXPECT_EQ(s.euler, a.euler);
+      ++surfaces;
+    }
+  }
+  EXPECT_GT(surfaces, 1000u);
+}
+
 TEST(FrontDoor, ProgressAndCancellation) {
   const Dims d{40, 40, 40};
   const std::vector<std::uint8_t> v = noisyBall<std::uint8_t>(d, 12, 4);

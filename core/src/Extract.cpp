@@ -203,8 +203,11 @@ void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mappin
     for (auto& t : out.triangles) std::swap(t[1], t[2]);
 }
 
-void addFigures(Surface& out) {
-  out.components = componentFigures(out.vertices, out.triangles);
+void addFigures(Surface& out, bool connected) {
+  if (connected && !out.triangles.empty())
+    out.components = {connectedMeshFigures(out.vertices, out.triangles)};
+  else
+    out.components = componentFigures(out.vertices, out.triangles);
   out.euler = 0;
   for (const ComponentFigures& c : out.components) out.euler += c.euler;
 }
@@ -319,7 +322,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
                    (o.seed.kind == Kind::All || o.seed.kind == Kind::Largest ? binary.dims().count() : 0);
 
   stages.begin("figures");
-  if (o.figures) addFigures(out);
+  if (o.figures) addFigures(out, /*connected=*/!scanning);  // one tracked boundary, unless scanning
   if (scanning) out.boundariesInImage = out.components.size();
   stages.end();
   // A seeded surface of a handful of voxels in a large image is most likely noise reached by

@@ -16,7 +16,15 @@ namespace surftrack {
 void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mapping,
                   const Selection& selection, double epsilon, Surface& out, int threads = 1);
 
-/// Sets out.components and out.euler from its vertices and triangles.
-void addFigures(Surface& out);
+/// Sets out.components and out.euler from its vertices and triangles. `connected`: they are
+/// known to form one component — one boundary tracked from its seed, whose surface graph is
+/// connected (trackComponent) and whose every edge lies on a triangulated loop (paper §5.2) —
+/// so no union-find is run to find the components.
+void addFigures(Surface& out, bool connected = false);
+
+/// The figures of a mesh that is one connected component (componentFigures' sums, in the same
+/// order: the same bits).
+ComponentFigures connectedMeshFigures(const std::vector<std::array<double, 3>>& vertices,
+                                      const std::vector<std::array<std::uint32_t, 3>>& triangles);
 
 }  // namespace surftrack
