@@ -36,8 +36,11 @@ void store(const SurfaceMesh& mesh, Surface& s) {
 }
 
 /// The enclosed volume of the surface, from its triangles (its components may not be computed:
-/// extract with figures off).
+/// extract with figures off); a surface of one component (one tracked boundary) needs no
+/// union-find to find it.
 double volumeOf(const Surface& s) {
+  if (s.components.size() == 1 && s.components[0].triangles == s.triangles.size())
+    return connectedMeshFigures(s.vertices, s.triangles).volume;
   double v = 0;
   for (const ComponentFigures& c : componentFigures(s.vertices, s.triangles)) v += c.volume;
   return v;
@@ -124,6 +127,7 @@ RefineReport refineSurface(Surface& surface, const RefineOptions& o) {
   }
   if (report.smooth) report.volumeBefore = report.smooth->volumeBefore;
   else if (report.decimate) report.volumeBefore = report.decimate->volumeBefore;
+  else if (!surface.components.empty()) report.volumeBefore = storedVolume(surface);  // nothing to do: no pass
   else report.volumeBefore = volumeOf(surface);
   if (report.decimate) report.volumeAfter = report.decimate->volumeAfter;
   else if (report.smooth) report.volumeAfter = report.smooth->volumeAfter;
