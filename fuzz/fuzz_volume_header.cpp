@@ -1,5 +1,5 @@
 // libFuzzer target: arbitrary bytes as a volume file of one format, "mha", "mhd", "nrrd",
-// "nhdr", "nii" or "raw", named by the program's name: fuzz_volume_header_<format> (one binary,
+// "nhdr", "nii", "nii.gz" or "raw", named by the program's name: fuzz_volume_header_<format> (one binary,
 // one link to it per format, fuzz/CMakeLists.txt).
 //
 // Each input goes through
@@ -127,7 +127,8 @@ void fuzzRaw(const uint8_t* data, size_t size) {
 }
 
 void fuzzFile(const uint8_t* data, size_t size) {
-  parseBuffer(std::string_view(reinterpret_cast<const char*>(data), size));
+  if (gFormat != "nii.gz")  // (gzip'd bytes: the parser sees them inflated, through the loader)
+    parseBuffer(std::string_view(reinterpret_cast<const char*>(data), size));
   writeInput(data, size);
   io::LoadedVolume loaded;
   try {
@@ -152,8 +153,8 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   const std::string prefix = "fuzz_volume_header_";
   gFormat = name.rfind(prefix, 0) == 0 ? name.substr(prefix.size()) : "";
   if (gFormat != "mha" && gFormat != "mhd" && gFormat != "nrrd" && gFormat != "nhdr" && gFormat != "nii" &&
-      gFormat != "raw")
-    fail("run me as fuzz_volume_header_<format>, format mha, mhd, nrrd, nhdr, nii or raw (not '" + name + "')");
+      gFormat != "nii.gz" && gFormat != "raw")
+    fail("run me as fuzz_volume_header_<format>, format mha, mhd, nrrd, nhdr, nii, nii.gz or raw (not '" + name + "')");
   // One directory per process (libFuzzer's -jobs/-workers run several): under /dev/shm when
   // there is one, so that the inputs never reach a disk.
   const fs::path base = fs::exists("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();

@@ -1,7 +1,7 @@
 // Writes the seed corpus of fuzz/fuzz_volume_header.cpp: small valid files of every format,
 // written by ITK (io::writeVolume) where ITK writes them and by hand for what it does not
 // (big-endian voxels, byte skips, HeaderSize), in <dir>/<format>/ for the formats mha, mhd,
-// nrrd, nhdr, nii and raw. Detached headers are rewritten to name "data.raw", the data file
+// nrrd, nhdr, nii, nii.gz and raw. Detached headers are rewritten to name "data.raw", the data file
 // the fuzz target puts next to each input. Usage: make_seed_corpus <dir>
 #include <cmath>
 #include <cstdio>
@@ -78,6 +78,7 @@ int main(int argc, char** argv) {
       written(v, ext, tag, false);
       if (ext != "nii") written(v, ext, tag, true);
     }
+    written(v, "nii.gz", tag, false);  // (always gzip'd)
   }
   // By hand: what ITK does not write.
   const std::string nrrdStart =
@@ -106,7 +107,9 @@ int main(int argc, char** argv) {
   {
     DenseImage<float> image(Dims{3, 4, 2}, 1.5f, geometry());
     image.at(1, 1, 1) = std::nanf("");
-    written(io::AnyVolume(std::move(image)), "nii", "nan-float", false);
+    const io::AnyVolume v(std::move(image));
+    written(v, "nii", "nan-float", false);
+    written(v, "nii.gz", "nan-float", false);
   }
   // Raw: 5 bytes of layout (type | 0x80 for big-endian, header bytes, nx - 1, ny - 1, nz - 1),
   // then the file (fuzz/fuzz_volume_header.cpp, fuzzRaw).

@@ -631,6 +631,8 @@ TEST(LoadVolume, GzippedNiftiMembersAndTrailingBytesReadAsItkReadsThem) {
       // bgzip and pigz --independent write several members; the first ends inside the header.
       {"members.nii.gz", gzipped(nii, {200, 1000, 1}), "inflated"},
       {"trailing.nii.gz", gzipped(nii) + "not a gzip member", "inflated"},
+      // bgzip's end: an empty member after the last.
+      {"emptylast.nii.gz", gzipped(nii) + gzipped(""), "inflated"},
       // More bytes than the header announces: ITK reads what it needs.
       {"longer.nii.gz", gzipped(nii + std::string(100, 'x')), "inflated"},
   };
@@ -681,6 +683,8 @@ TEST(LoadVolume, DamagedGzippedNiftiIsAReadError) {
       {"cutheader.nii.gz", gz.substr(0, 20), "truncated"},
       {"short.nii.gz", gzipped(nii.substr(0, nii.size() - 10)), "truncated"},
       {"flipped.nii.gz", flipped, "corrupt compressed data"},
+      // A damaged member after those that hold the voxels: readVolume reads to the end too.
+      {"damagedlast.nii.gz", gz + gzipped(std::string(5000, 'x')).substr(0, 30), "corrupt compressed data"},
       {"plain.nii.gz", nii, "not gzip-compressed"},
       {"garbage.nii.gz", std::string("\x1f\x8bneither is this"), "corrupt compressed data"},
       {"nansform.nii.gz", gzipped(nanSform), "sform"},  // ITK's reader would abort the process
