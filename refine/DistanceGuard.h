@@ -43,6 +43,7 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     MeshT& m = Base::mesh();
     if (!samplesOf_.is_valid()) m.add_property(samplesOf_);
     original_.clear();
+    originalBox_.clear();
     lastHit_ = 0;
     // Cells about twice the larger of the tolerance and the mean edge length: a triangle
     // meets a few cells, a query a few more.
@@ -52,12 +53,12 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
       const Triangle3 t = triangleOf(m, f);
       originalGrid_.insert(std::uint32_t(original_.size()), 0, boxOf(t));
       original_.push_back(t);
+      originalBox_.push_back(boxOf(t));
       auto& list = m.property(samplesOf_, f);
       list.clear();
       list.push_back({(t[0][0] + t[1][0] + t[2][0]) / 3, (t[0][1] + t[1][1] + t[2][1]) / 3,
                       (t[0][2] + t[1][2] + t[2][2]) / 3});
     }
-    originalGrid_.compact();
     for (auto e : m.edges()) {
       const auto h = m.halfedge_handle(e, 0);
       const auto a = m.point(m.from_vertex_handle(h)), b = m.point(m.to_vertex_handle(h));
@@ -148,9 +149,9 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     }
     bool found = false;
     const Box3 query = boxOf({p, p, p}, tolerance_);
-    // Only a triangle whose box meets the query box can be within the tolerance.
     originalGrid_.near(query, [&](std::uint32_t id, std::uint32_t) {
-      if (!found && squaredDistanceToTriangle(p, original_[id]) <= e2) {
+      // Only a triangle whose box meets the query box can be within the tolerance.
+      if (!found && originalBox_[id].meets(query) && squaredDistanceToTriangle(p, original_[id]) <= e2) {
         found = true;
         lastHit_ = id;
       }
@@ -179,6 +180,7 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
 
   double tolerance_ = 1;
   std::vector<Triangle3> original_, created_;
+  std::vector<Box3> originalBox_;
   std::vector<FaceHandle> createdFace_, assigned_;
   std::vector<Point3> pending_;
   std::uint32_t lastHit_ = 0;

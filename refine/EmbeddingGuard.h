@@ -40,35 +40,29 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     MeshT& m = Base::mesh();
     // The triangles the collapse creates: v0's faces but the two on the collapsing edge.
     created_.clear();
-    Box3 all{{0, 0, 0}, {0, 0, 0}};
     forEachCreatedTriangle(m, ci, [&](FaceHandle, const std::array<VertexHandle, 3>& ids, const Triangle3& p) {
       created_.push_back({ids, p, boxOf(p, tolerance_)});
-      all = created_.size() == 1 ? created_.back().box : unite(all, created_.back().box);
     });
-    for (std::size_t i = 0; i < created_.size(); ++i)
+    for (std::size_t i = 0; i < created_.size(); ++i) {
       for (std::size_t j = i + 1; j < created_.size(); ++j)
         if (created_[i].box.meets(created_[j].box) && meet(created_[i], created_[j])) return float(Base::ILLEGAL_COLLAPSE);
-    // Old triangles near them, but those of v0 (removed or replaced): only one whose box meets
-    // a created one's (enlarged by the tolerance) can meet it. They all lie around v1, so the
-    // grid is asked once, for the box of them all, and each old triangle it gives is tested
-    // against the created ones whose boxes its box meets: the same pairs as one query each.
-    ++stamp_;
-    near_.clear();
-    grid_.near(all, [&](FaceHandle f) {
-      if (seen(f)) return;
-      Face u;
-      auto h = m.halfedge_handle(f);
-      for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) {
-        u.id[k] = m.to_vertex_handle(h);
-        if (u.id[k] == ci.v0) return;
-        u.p[k] = pointOf(m.point(u.id[k]));
-      }
-      u.box = boxOf(u.p);
-      near_.push_back(u);
-    });
-    for (const Face& t : created_)
-      for (const Face& u : near_)
-        if (t.box.meets(u.box) && meet(t, u)) return float(Base::ILLEGAL_COLLAPSE);
+      // Old triangles near it, but those of v0 (removed or replaced): only one whose box meets
+      // the created one's (enlarged by the tolerance) can meet it.
+      ++stamp_;
+      bool illegal = false;
+      grid_.near(created_[i].box, [&](FaceHandle f) {
+        if (illegal || seen(f)) return;
+        Face u;
+        auto h = m.halfedge_handle(f);
+        for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) {
+          u.id[k] = m.to_vertex_handle(h);
+          if (u.id[k] == ci.v0) return;
+          u.p[k] = pointOf(m.point(u.id[k]));
+        }
+        illegal = meet(created_[i], u);
+      });
+      if (illegal) return float(Base::ILLEGAL_COLLAPSE);
+    }
     return float(Base::LEGAL_COLLAPSE);
   }
 
@@ -103,7 +97,7 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
 
   double tolerance_ = 1e-9;
   LiveTriangleGrid<MeshT> grid_;
-  std::vector<Face> created_, near_;
+  std::vector<Face> created_;
   std::vector<std::uint64_t> mark_;
   std::uint64_t stamp_ = 0;
 };

@@ -60,13 +60,13 @@ double meanEdgeLength(const MeshT& m) {
 }
 
 /// A TriangleGrid of the current faces of a mesh under halfedge collapses: the faces a collapse
-/// changes (those around the surviving vertex) are entered again after it with a new version,
-/// so every face is listed in the cells of its current box with its current version, and a
-/// query skips (and unlinks) the entries of older versions, which the grid's boxes let it
-/// do for the entries near the query box alone. Cells are about twice the larger of
-/// `minimumCell` and the mean edge length; as the collapses make the triangles larger and leave
-/// stale entries, the grid is rebuilt from the live faces whenever their number has halved, so
-/// a query meets a few cells of a few ids whatever the stage of the decimation.
+/// changes (those around the surviving vertex) are entered again after it, so every face is
+/// listed in the cells of its current box, and the box of every face is kept in a flat array,
+/// so that a query skips the stale ids and the faces whose boxes miss it without reading the
+/// mesh. Cells are about twice the larger of `minimumCell` and the mean edge length; as the
+/// collapses make the triangles larger and leave stale ids, the grid is rebuilt from the live
+/// faces whenever their number has halved, so a query meets a few cells of a few ids whatever
+/// the stage of the decimation.
 template <class MeshT>
 class LiveTriangleGrid {
  public:
@@ -75,18 +75,23 @@ class LiveTriangleGrid {
 
   void build(const MeshT& m, double minimumCell) {
     minimumCell_ = minimumCell;
-    live_ = m.n_faces();
-    builtWith_ = live_;
+    live_ = 0;
+    box_.assign(m.n_faces(), kNoBox);
     version_.resize(m.n_faces(), 0);
+    for (auto f : m.faces()) {
+      box_[f.idx()] = boxOf(triangleOf(m, f));
+      ++live_;
+    }
+    builtWith_ = live_;
     grid_.reset(boundsOf(m), 2 * std::max(minimumCell_, meanEdgeLength(m)));
-    for (auto f : m.faces()) grid_.insert(std::uint32_t(f.idx()), version_[f.idx()], boxOf(triangleOf(m, f)));
-    grid_.compact();
+    for (auto f : m.faces()) grid_.insert(std::uint32_t(f.idx()), version_[f.idx()], box_[f.idx()]);
   }
 
   /// After the collapse of a halfedge into v1 that removed faces fl and fr.
   void collapsed(const MeshT& m, VertexHandle v1, FaceHandle fl, FaceHandle fr) {
     for (FaceHandle f : {fl, fr})
       if (f.is_valid()) {
+        box_[f.idx()] = kNoBox;
         ++version_[f.idx()];
         --live_;
       }
@@ -94,16 +99,21 @@ class LiveTriangleGrid {
       build(m, minimumCell_);
       return;
     }
-    for (auto f : m.vf_range(v1)) grid_.insert(std::uint32_t(f.idx()), ++version_[f.idx()], boxOf(triangleOf(m, f)));
+    for (auto f : m.vf_range(v1)) {
+      box_[f.idx()] = boxOf(triangleOf(m, f));
+      grid_.insert(std::uint32_t(f.idx()), ++version_[f.idx()], box_[f.idx()]);
+    }
   }
 
-  /// Calls visit(f) for the live faces whose boxes (rounded outwards, FloatBox) meet `box`,
-  /// each once per cell of `box` it meets (and unlinks the stale entries among them).
+  /// Calls visit(f) for the live faces whose boxes meet `box`, each once per cell of `box` it
+  /// meets (and unlinks the stale entries it walks over).
   template <class Visit>
   void near(const Box3& box, Visit&& visit) {
     grid_.sweep(
         box, [&](std::uint32_t id, std::uint32_t version) { return version != version_[id]; },
-        [&](std::uint32_t id, std::uint32_t) { visit(FaceHandle(int(id))); });
+        [&](std::uint32_t id, std::uint32_t) {
+          if (box_[id].meets(box)) visit(FaceHandle(int(id)));
+        });
   }
 
   /// The bounding box of the mesh's points (which halfedge collapses never move).
@@ -122,7 +132,9 @@ class LiveTriangleGrid {
   }
 
  private:
+  static constexpr Box3 kNoBox{{1, 1, 1}, {-1, -1, -1}};  // meets no box
   TriangleGrid grid_;
+  std::vector<Box3> box_;
   std::vector<std::uint32_t> version_;
   double minimumCell_ = 0;
   std::size_t live_ = 0, builtWith_ = 0;

@@ -1,8 +1,8 @@
 // A uniform grid of triangles' bounding boxes, for the decimation guards (docs/theory.md,
 // section 10): every triangle id is listed in each cell its box meets, so the triangles whose
-// boxes may meet a query box are found in the cells of that box. Entries are never erased:
+// boxes may meet a query box are found in the cells of that box. Entries are never removed:
 // callers tag them and skip the stale ones (LiveTriangleGrid in MeshTriangles.h, which also
-// rebuilds the grid as the triangles grow).
+// rebuilds the grid when they pile up).
 #pragma once
 
 #include <algorithm>
@@ -24,16 +24,6 @@ struct Box3 {
   }
 };
 
-/// The smallest box holding a and b.
-inline Box3 unite(const Box3& a, const Box3& b) {
-  Box3 u;
-  for (int k = 0; k < 3; ++k) {
-    u.lo[k] = std::min(a.lo[k], b.lo[k]);
-    u.hi[k] = std::max(a.hi[k], b.hi[k]);
-  }
-  return u;
-}
-
 /// The bounding box of t, enlarged by `margin` on every side.
 inline Box3 boxOf(const Triangle3& t, double margin = 0) {
   Box3 b;
@@ -44,31 +34,9 @@ inline Box3 boxOf(const Triangle3& t, double margin = 0) {
   return b;
 }
 
-/// A box of floats holding a given box (rounded outwards): an entry of the grid carries its
-/// triangle's box in half the room, so that a query tests it where it reads the entry. It may
-/// meet a box the exact one misses, never the other way.
-struct FloatBox {
-  std::array<float, 3> lo, hi;
-  static FloatBox around(const Box3& b) {
-    FloatBox f;
-    for (int k = 0; k < 3; ++k) {
-      f.lo[k] = float(b.lo[k]);
-      if (double(f.lo[k]) > b.lo[k]) f.lo[k] = std::nextafter(f.lo[k], -INFINITY);
-      f.hi[k] = float(b.hi[k]);
-      if (double(f.hi[k]) < b.hi[k]) f.hi[k] = std::nextafter(f.hi[k], INFINITY);
-    }
-    return f;
-  }
-  bool meets(const Box3& o) const {
-    return double(lo[0]) <= o.hi[0] && o.lo[0] <= double(hi[0]) && double(lo[1]) <= o.hi[1] &&
-           o.lo[1] <= double(hi[1]) && double(lo[2]) <= o.hi[2] && o.lo[2] <= double(hi[2]);
-  }
-};
-
 /// The grid covers a fixed bounding box (queries beyond it are clipped to it: every triangle
 /// entered must lie inside it) with at most about 2^24 cells; each cell holds the head of a
-/// list of entries in one pool, so an insertion is a push and a query walks a few short lists. Every entry carries its triangle's box (FloatBox), so a query skips
-/// the triangles whose boxes miss it without reading anything else.
+/// list of entries in one pool, so an insertion is a push and a query walks a few short lists.
 class TriangleGrid {
  public:
   /// An empty grid of cells of about `cell` over `bounds`.
@@ -81,41 +49,25 @@ class TriangleGrid {
     head_.assign(std::size_t(size_[0] * size_[1] * size_[2]), kEnd);
     entries_.clear();
   }
+  double cell() const { return cell_; }
+  /// Entries listed, over all cells (with the stale ones).
+  std::size_t entries() const { return entries_.size(); }
 
   /// Lists `id`, with `tag`, in every cell that `box` meets.
   void insert(std::uint32_t id, std::uint32_t tag, const Box3& box) {
     std::array<long, 3> lo, hi;
     range(box, lo, hi);
-    const FloatBox f = FloatBox::around(box);
     for (long z = lo[2]; z <= hi[2]; ++z)
       for (long y = lo[1]; y <= hi[1]; ++y)
         for (long x = lo[0]; x <= hi[0]; ++x) {
           std::uint32_t& h = head_[index(x, y, z)];
-          entries_.push_back({id, tag, h, f});
+          entries_.push_back({id, tag, h});
           h = std::uint32_t(entries_.size() - 1);
         }
   }
 
-  /// Lays every cell's list out contiguously in the pool, in its order. Entries go into the pool
-  /// in insertion order, so after a bulk insertion (all the triangles of a mesh) a cell's list
-  /// jumps across the pool and a query misses the cache at every entry; packed, it reads a few
-  /// consecutive entries. Lists, and so queries, are unchanged.
-  void compact() {
-    std::vector<Entry> packed;
-    packed.reserve(entries_.size());
-    for (std::uint32_t& h : head_) {
-      if (h == kEnd) continue;
-      const auto first = std::uint32_t(packed.size());
-      for (std::uint32_t e = h; e != kEnd; e = entries_[e].next)
-        packed.push_back({entries_[e].id, entries_[e].tag, std::uint32_t(packed.size() + 1), entries_[e].box});
-      packed.back().next = kEnd;
-      h = first;
-    }
-    entries_.swap(packed);
-  }
-
-  /// Calls visit(id, tag) for every entry of a cell that `box` meets whose own box (rounded
-  /// outwards) meets `box` (an id may come several times, once per cell).
+  /// Calls visit(id, tag) for every entry of a cell that `box` meets (an id may come several
+  /// times).
   template <class Visit>
   void near(const Box3& box, Visit&& visit) const {
     std::array<long, 3> lo, hi;
@@ -124,11 +76,11 @@ class TriangleGrid {
       for (long y = lo[1]; y <= hi[1]; ++y)
         for (long x = lo[0]; x <= hi[0]; ++x)
           for (std::uint32_t e = head_[index(x, y, z)]; e != kEnd; e = entries_[e].next)
-            if (entries_[e].box.meets(box)) visit(entries_[e].id, entries_[e].tag);
+            visit(entries_[e].id, entries_[e].tag);
   }
 
   /// The same, but the entries for which stale(id, tag) holds are unlinked from their cells
-  /// instead of visited (those whose boxes miss `box` are left, unasked).
+  /// instead of visited.
   template <class Stale, class Visit>
   void sweep(const Box3& box, Stale&& stale, Visit&& visit) {
     std::array<long, 3> lo, hi;
@@ -138,9 +90,7 @@ class TriangleGrid {
         for (long x = lo[0]; x <= hi[0]; ++x)
           for (std::uint32_t* link = &head_[index(x, y, z)]; *link != kEnd;) {
             Entry& e = entries_[*link];
-            if (!e.box.meets(box)) {
-              link = &e.next;
-            } else if (stale(e.id, e.tag)) {
+            if (stale(e.id, e.tag)) {
               *link = e.next;
             } else {
               visit(e.id, e.tag);
@@ -152,7 +102,6 @@ class TriangleGrid {
  private:
   struct Entry {
     std::uint32_t id, tag, next;
-    FloatBox box;
   };
   static constexpr std::uint32_t kEnd = 0xFFFFFFFFu;
 
