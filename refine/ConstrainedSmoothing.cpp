@@ -234,7 +234,9 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   for (const auto& tr : triangle)
     for (std::uint32_t v : tr) ++ringStart[v + 1];
   for (std::size_t v = 0; v < nv; ++v) ringStart[v + 1] += ringStart[v];
-  std::vector<std::uint32_t> ring(3 * nf);
+  // Each ring is stored closed, r_0 .. r_{k-1} r_0, at ringStart[v] + v, so that the walk over
+  // its triangles has no wrap-around test.
+  std::vector<std::uint32_t> ring(3 * nf + nv);
   std::vector<double> inverseDegree(nv);  // the Laplacian's weight, a product in the passes
   {
     // First each corner's (next, previous) pair, in triangle order, then the chains.
@@ -249,13 +251,15 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
           inverseDegree[v] = 1.0 / double(last - first);
           std::uint32_t b = corner[first][0], c = corner[first][1];
           for (std::uint32_t k = first; k < last; ++k) {
-            ring[k] = b;
+            ring[k + v] = b;
             // The corner whose next vertex is c comes next (a single fan: exactly one).
             std::uint32_t m = first;
-            while (corner[m][0] != c) ++m;
+            while (m < last && corner[m][0] != c) ++m;
+            if (m == last) throw std::logic_error("smoothOnSegments: a vertex's triangles are not one fan");
             b = c;
             c = corner[m][1];
           }
+          ring[last + v] = ring[first + v];
         }
       });
     });
@@ -278,12 +282,11 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
       // The umbrella Laplacian and the area-weighted normal, the sum over the triangles
       // (v, r_i, r_{i+1}) of (r_i - v) x (r_{i+1} - v).
       const Point3 xv = xs[v];
-      const std::uint32_t first = ringStart[v], last = ringStart[v + 1];
+      const std::size_t first = ringStart[v] + v, last = ringStart[v + 1] + v;
       Point3 sum{0, 0, 0}, n{0, 0, 0};
-      const Point3 a0 = sub(xs[rs[first]], xv);
-      Point3 a = a0;
-      for (std::uint32_t k = first + 1; k <= last; ++k) {
-        const Point3 b = k < last ? sub(xs[rs[k]], xv) : a0;
+      Point3 a = sub(xs[rs[first]], xv);
+      for (std::size_t k = first + 1; k <= last; ++k) {
+        const Point3 b = sub(xs[rs[k]], xv);
         const Point3 tn = cross(a, b);
         for (int i = 0; i < 3; ++i) {
           sum[i] += a[i];
