@@ -74,6 +74,13 @@ inline double threadCpuSeconds() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
+/// CPU seconds of all the process's threads (for parallel code, next to wallSeconds).
+inline double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
 /// The median (mean of the two middle values for an even count); NaN for no value.
 inline double median(std::vector<double> v) {
   if (v.empty()) return NAN;

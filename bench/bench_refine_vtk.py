@@ -9,8 +9,11 @@ on the same mesh: vtkWindowedSincPolyDataFilter with the same number of iteratio
 reduction. Reports for each result the RMS of |x - c| - R over the vertices (the sphere only),
 the enclosed volume against the extracted mesh's, the times, and, from surftrack_mesh_check
 (CGAL, tests/mesh_check.cpp; --skip-checks leaves it out), closedness, genus and
-self-intersecting triangle pairs. Times are wall and CPU seconds of the calls alone (surftrack's
-thread, VTK's process). Renders a before/after PNG with gnuplot.
+self-intersecting triangle pairs. Times are wall and CPU seconds of the calls alone (the
+process's CPU time, all threads, for surftrack's smoothing and for VTK; the thread's for
+surftrack's decimation, which runs on one). Both smoothings get the same thread count (--threads,
+default 2: surftrack's SmoothOptions::threads, VTK's vtkSMPTools, whose backend is TBB in
+Debian's VTK); decimation is serial in both. Renders a before/after PNG with gnuplot.
 
 Needs Debian's /usr/bin/python3 with numpy and vtk 9 (python3-vtk9).
 """
@@ -93,6 +96,8 @@ def main():
     ap.add_argument("--reduce", type=float, default=0.9, help="fraction of triangles removed, both tools (default 0.9)")
     ap.add_argument("--lambda", dest="lam", type=float, help="surftrack's Taubin lambda (default: SmoothOptions')")
     ap.add_argument("--mu", type=float, help="surftrack's Taubin mu (default: SmoothOptions')")
+    ap.add_argument("--threads", type=int, default=2,
+                    help="threads of both smoothings (default 2; surftrack's 0 is all cores)")
     ap.add_argument("--passband", type=float, default=0.1, help="vtkWindowedSincPolyDataFilter pass band (default 0.1)")
     ap.add_argument("--out", default="bench-refine", help="directory for the meshes (default bench-refine)")
     ap.add_argument("--png", help="write the before/after picture here")
@@ -104,7 +109,7 @@ def main():
     bench = os.path.join(a.build, "bench", "bench_refine")
     tool = os.path.join(a.build, "tests", "surftrack_mesh_check")
     command = [bench, "--size", str(a.size), "--iterations", str(a.iterations), "--max-error", str(a.max_error),
-               "--reduce", str(a.reduce), "--out", a.out]
+               "--reduce", str(a.reduce), "--threads", str(a.threads), "--out", a.out]
     if a.input:
         command += ["--input", a.input, "--iso", str(a.iso)]
     if a.lam is not None:
@@ -116,6 +121,8 @@ def main():
     midpoint = read_ply(os.path.join(a.out, "sphere-midpoint.ply"))
 
     smoothing = a.iterations > 0
+    if a.threads > 0:
+        vtk.vtkSMPTools.Initialize(a.threads)
     sinc = vtk.vtkWindowedSincPolyDataFilter()
     sinc.SetInputData(midpoint)
     sinc.SetNumberOfIterations(a.iterations)
@@ -162,7 +169,8 @@ def main():
                      "self_intersecting_pairs": c["self_intersecting_pairs"]})
     what = f"{a.input} at {a.iso:g}" if a.input else f"binary clean sphere q = {a.size}, R = {radius:g}"
     taubin = "" if a.lam is None and a.mu is None else f" (surftrack lambda {a.lam}, mu {a.mu})"
-    print(f"{what}; {a.iterations} iterations{taubin}; reduce {a.reduce}; "
+    print(f"{what}; {a.iterations} iterations{taubin}; {a.threads} smoothing threads "
+          f"(VTK SMP {vtk.vtkSMPTools.GetBackend()}, {vtk.vtkSMPTools.GetEstimatedNumberOfThreads()}); reduce {a.reduce}; "
           f"surftrack max error {a.max_error}; load average {os.getloadavg()[0]:.2f}")
     print(f"{'result':24s} {'triangles':>9s} {'RMS':>8s} {'drop':>6s} {'volume':>9s} {'time s':>7s} {'cpu s':>7s} "
           f"{'genus':>6s} {'manifold':>8s} {'self-int':>8s}")

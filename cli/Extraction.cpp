@@ -203,6 +203,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   if (o.refine.smoothIterations > 0) {
     SmoothOptions so;
     so.iterations = o.refine.smoothIterations;
+    so.threads = o.threads;
     ro.smooth = so;
   }
   if (o.refine.decimate()) {

@@ -455,8 +455,8 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
   a.seedRules = {seed, seedRay, seedPoint, a.largest, a.all};
 
   addSurfaceOptions(app, o.surface.pair, o.ascii, o.surface.threads,
-                    "threads for the scan of --largest / --all (default 0: all\n"
-                    "cores); the mesh is the same for any number");
+                    "threads for the scan of --largest / --all and for --smooth\n"
+                    "(default 0: all cores); the mesh is the same for any number");
   a.mapping = app.add_option("--mapping", mapping,
                              "linear (default with --iso: vertices at the interpolated iso-value)\n"
                              "or midpoint (vertices halfway between the two voxels)")

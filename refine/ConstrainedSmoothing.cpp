@@ -6,11 +6,16 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include <tbb/blocked_range.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include "BoundaryMapping.h"
 #include "CubeFoldCheck.h"
 #include "DigitalCube.h"
 #include "FoldCertificate.h"
-#include "VertexNormals.h"
+#include "SurfaceMesh.h"
 
 namespace surftrack::refine {
 
@@ -40,6 +45,17 @@ struct Lists {
   }
 };
 
+/// Calls body(begin, end) over blocks of [0, n): on this thread for one thread or a small n,
+/// else in parallel. The bodies here write only their own items, from data no block writes,
+/// so the result does not depend on the blocks or the thread count.
+template <class Body>
+void forBlocks(std::size_t n, bool parallel, Body&& body) {
+  if (!parallel) body(std::size_t(0), n);
+  else
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+}
+
 Lists invert(const std::vector<std::uint32_t>& owner, std::size_t count) {
   Lists out;
   out.start.assign(count + 1, 0);
@@ -53,74 +69,97 @@ Lists invert(const std::vector<std::uint32_t>& owner, std::size_t count) {
 
 }  // namespace
 
-SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometry,
-                                 const SmoothingParameters& p) {
+SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfel,
+                                 const std::vector<std::array<std::uint32_t, 3>>& triangle,
+                                 const ImageGeometry& geometry, const SmoothingParameters& p) {
   requireParameters(p);
-  const auto surfelHandle = surfelProperty(mesh);
-  const std::size_t nv = mesh.n_vertices(), nf = mesh.n_faces();
+  if (p.threads < 0) throw std::invalid_argument("smoothing threads " + std::to_string(p.threads) + " is negative");
+  const std::size_t nv = points.size(), nf = triangle.size();
+  if (surfel.size() != nv)
+    throw std::invalid_argument("smoothing: " + std::to_string(surfel.size()) + " surfels for " + std::to_string(nv) +
+                                " vertices");
+  // The one-rings below read each vertex's neighbours off its corners, which takes a closed,
+  // oriented 2-manifold (section 8: every continuous analog is one).
+  requireClosedOrientedManifold(nv, triangle);
   SmoothingReport report;
+  // Passes over the vertices in parallel (threads 0: all cores) but for a small mesh, where a
+  // pass costs less than waking the threads.
+  const bool parallel = p.threads != 1 && nv >= (std::size_t(1) << 12);
+  // More threads than cores would only wait for each other (and make TBB warn that its workers
+  // are limited): the arena gets the cores at most.
+  tbb::task_arena arena(p.threads > 0 ? std::min(p.threads, tbb::info::default_concurrency())
+                                      : tbb::task_arena::automatic);
 
   // Each vertex's segment in physical space, P(c) + t (P(d) - P(c)) (toPhysical is affine),
   // and in index space, c + t (d - c), where the fold check works.
-  std::vector<Surfel> surfel(nv);
-  std::vector<Point3> base(nv), axis(nv), start(nv), indexBase(nv), indexAxis(nv);
+  std::vector<Point3> base(nv), axis(nv), indexBase(nv), indexAxis(nv);
   std::vector<double> inverseLength2(nv), t(nv);
-  for (std::size_t v = 0; v < nv; ++v) {
-    const auto vh = mesh.vertex_handle(unsigned(v));
-    const Surfel s = mesh.property(surfelHandle, vh);
-    surfel[v] = s;
-    const Voxel c = s.inside(), d = s.outside();
-    indexBase[v] = {double(c.x), double(c.y), double(c.z)};
-    indexAxis[v] = {double(d.x - c.x), double(d.y - c.y), double(d.z - c.z)};
-    base[v] = geometry.toPhysical(indexBase[v]);
-    axis[v] = sub(geometry.toPhysical({double(d.x), double(d.y), double(d.z)}), base[v]);
-    inverseLength2[v] = 1.0 / dot(axis[v], axis[v]);
-    const auto& q = mesh.point(vh);
-    start[v] = {q[0], q[1], q[2]};
-    const Point3 r = sub(start[v], base[v]);
-    const double tv = dot(r, axis[v]) * inverseLength2[v];
-    double off = 0;
-    for (int k = 0; k < 3; ++k) off = std::max(off, std::abs(r[k] - tv * axis[v][k]));
-    if (!(tv > 0 && tv < 1) || off > 1e-6 * norm(axis[v])) {
-      std::ostringstream msg;
-      msg << "vertex " << v << " is not inside the segment of its " << s;
-      throw std::invalid_argument(msg.str());
-    }
-    t[v] = std::clamp(tv, p.epsilon, 1 - p.epsilon);
+  std::vector<char> offSegment(nv, 0);
+  arena.execute([&] {
+    forBlocks(nv, parallel, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t v = begin; v < end; ++v) {
+        const Voxel c = surfel[v].inside(), d = surfel[v].outside();
+        indexBase[v] = {double(c.x), double(c.y), double(c.z)};
+        indexAxis[v] = {double(d.x - c.x), double(d.y - c.y), double(d.z - c.z)};
+        base[v] = geometry.toPhysical(indexBase[v]);
+        axis[v] = sub(geometry.toPhysical({double(d.x), double(d.y), double(d.z)}), base[v]);
+        inverseLength2[v] = 1.0 / dot(axis[v], axis[v]);
+        const Point3 r = sub(points[v], base[v]);
+        const double tv = dot(r, axis[v]) * inverseLength2[v];
+        double off = 0;
+        for (int k = 0; k < 3; ++k) off = std::max(off, std::abs(r[k] - tv * axis[v][k]));
+        offSegment[v] = !(tv > 0 && tv < 1) || off > 1e-6 * norm(axis[v]);
+        t[v] = std::clamp(tv, p.epsilon, 1 - p.epsilon);
+      }
+    });
+  });
+  if (const auto bad = std::find(offSegment.begin(), offSegment.end(), 1); bad != offSegment.end()) {
+    const std::size_t v = std::size_t(bad - offSegment.begin());
+    std::ostringstream msg;
+    msg << "vertex " << v << " is not inside the segment of its " << surfel[v];
+    throw std::invalid_argument(msg.str());
   }
   auto indexPoint = [&](std::uint32_t v) {
     return Point3{indexBase[v][0] + t[v] * indexAxis[v][0], indexBase[v][1] + t[v] * indexAxis[v][1],
                   indexBase[v][2] + t[v] * indexAxis[v][2]};
   };
+  auto physicalPoint = [&](std::size_t v) {
+    return Point3{base[v][0] + t[v] * axis[v][0], base[v][1] + t[v] * axis[v][1], base[v][2] + t[v] * axis[v][2]};
+  };
 
   // Triangles by digital 3-cube (section 8: each has one), with the cube edges of their
-  // vertices and their reference normals (in index space at the midpoint mapping).
-  std::vector<std::array<std::uint32_t, 3>> triangle(nf);
-  std::vector<std::uint32_t> cubeOfFace(nf);
+  // vertices and their reference normals (in index space at the midpoint mapping). The cubes
+  // are numbered in the order of their first triangles.
+  std::vector<std::optional<Voxel>> cubeOf(nf);
   std::vector<CubeEdges> edgesOfFace(nf);
+  std::vector<Point3> reference(nf);
+  arena.execute([&] {
+    forBlocks(nf, parallel, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t f = begin; f < end; ++f) {
+        const auto& tr = triangle[f];
+        cubeOf[f] = cubeOfTriangle(surfel[tr[0]], surfel[tr[1]], surfel[tr[2]]);
+        if (!cubeOf[f]) continue;
+        for (int j = 0; j < 3; ++j) edgesOfFace[f][j] = std::uint8_t(cube::edgeOf(*cubeOf[f], surfel[tr[j]]));
+        reference[f] = triangleNormal({pointOnSurfel(surfel[tr[0]], 0.5), pointOnSurfel(surfel[tr[1]], 0.5),
+                                       pointOnSurfel(surfel[tr[2]], 0.5)});
+      }
+    });
+  });
+  std::vector<std::uint32_t> cubeOfFace(nf);
   std::unordered_map<Voxel, std::uint32_t> cubeIndex;  // std::hash<Voxel>: lib/Voxel.h
   cubeIndex.reserve(nf);
-  std::vector<Point3> reference(nf);
   for (std::size_t f = 0; f < nf; ++f) {
-    int k = 0;
-    for (auto vh : mesh.fv_range(mesh.face_handle(unsigned(f)))) triangle[f][k++] = std::uint32_t(vh.idx());
-    const auto& tr = triangle[f];
-    const std::optional<Voxel> m = cubeOfTriangle(surfel[tr[0]], surfel[tr[1]], surfel[tr[2]]);
-    if (!m) {
+    if (!cubeOf[f]) {
       std::ostringstream msg;
       msg << "triangle " << f << " has its vertices in no single digital 3-cube: constrained smoothing "
           << "needs the continuous analog itself (smooth before decimating)";
       throw std::invalid_argument(msg.str());
     }
-    cubeOfFace[f] = cubeIndex.try_emplace(*m, std::uint32_t(cubeIndex.size())).first->second;
-    for (int j = 0; j < 3; ++j) edgesOfFace[f][j] = std::uint8_t(cube::edgeOf(*m, surfel[tr[j]]));
-    reference[f] = triangleNormal({pointOnSurfel(surfel[tr[0]], 0.5), pointOnSurfel(surfel[tr[1]], 0.5),
-                                   pointOnSurfel(surfel[tr[2]], 0.5)});
+    cubeOfFace[f] = cubeIndex.try_emplace(*cubeOf[f], std::uint32_t(cubeIndex.size())).first->second;
   }
   const std::size_t nc = cubeIndex.size();
   report.cubes = nc;
   const Lists facesOfCube = invert(cubeOfFace, nc);
-
   // What the fold check of each cube must test in a pass: its triangles and pairs of triangles
   // without a certificate (FoldCertificate.h), single triangles first (the pair test needs
   // non-degenerate triangles). A cube with none is embedded at every position.
@@ -185,48 +224,98 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
     for (std::uint32_t& k : l.items) k = cubeOfChecked[k];
     return l;
   }();
-  // One-ring neighbours (uniform Laplacian).
-  Lists ring;
-  ring.start.assign(nv + 1, 0);
-  for (std::size_t v = 0; v < nv; ++v) {
-    for (auto w : mesh.vv_range(mesh.vertex_handle(unsigned(v)))) ring.items.push_back(std::uint32_t(w.idx()));
-    ring.start[v + 1] = std::uint32_t(ring.items.size());
+  // Each vertex's one-ring in cyclic order r_0 .. r_{k-1}, its triangles being (v, r_i,
+  // r_{i+1}) (indices mod k): in a closed, oriented manifold whose every vertex has a single fan
+  // (requireClosedOrientedManifold) the triangle (v, b, c) is followed around v by the one of
+  // the directed edge v -> c, (v, c, d). The ring gives both the uniform Laplacian and the
+  // area-weighted normal, with one read of each neighbour. Each ring starts at the next vertex
+  // of v's first triangle.
+  std::vector<std::uint32_t> ringStart(nv + 1, 0);
+  for (const auto& tr : triangle)
+    for (std::uint32_t v : tr) ++ringStart[v + 1];
+  for (std::size_t v = 0; v < nv; ++v) ringStart[v + 1] += ringStart[v];
+  // Each ring is stored closed, r_0 .. r_{k-1} r_0, at ringStart[v] + v, so that the walk over
+  // its triangles has no wrap-around test.
+  std::vector<std::uint32_t> ring(3 * nf + nv);
+  std::vector<double> inverseDegree(nv);  // the Laplacian's weight, a product in the passes
+  {
+    // First each corner's (next, previous) pair, in triangle order, then the chains.
+    std::vector<std::array<std::uint32_t, 2>> corner(3 * nf);
+    std::vector<std::uint32_t> next(ringStart.begin(), ringStart.end() - 1);
+    for (const auto& tr : triangle)
+      for (int j = 0; j < 3; ++j) corner[next[tr[j]]++] = {tr[(j + 1) % 3], tr[(j + 2) % 3]};
+    arena.execute([&] {
+      forBlocks(nv, parallel, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t v = begin; v < end; ++v) {
+          const std::uint32_t first = ringStart[v], last = ringStart[v + 1];
+          inverseDegree[v] = 1.0 / double(last - first);
+          std::uint32_t b = corner[first][0], c = corner[first][1];
+          for (std::uint32_t k = first; k < last; ++k) {
+            ring[k + v] = b;
+            // The corner whose next vertex is c comes next (a single fan: exactly one).
+            std::uint32_t m = first;
+            while (m < last && corner[m][0] != c) ++m;
+            if (m == last) throw std::logic_error("smoothOnSegments: a vertex's triangles are not one fan");
+            b = c;
+            c = corner[m][1];
+          }
+          ring[last + v] = ring[first + v];
+        }
+      });
+    });
   }
 
+  // The passes are Jacobi updates: every vertex reads the points x of the pass's start and
+  // writes its own t, previous and next point alone, so a pass's result does not depend on the
+  // order of the vertices or on the thread count.
   std::vector<double> previous(nv);
-  std::vector<Point3> x(nv), normal;
+  std::vector<Point3> x(nv), xNext(nv);
+  for (std::size_t v = 0; v < nv; ++v) x[v] = physicalPoint(v);
   std::vector<int> halved(nv);
   std::vector<char> queued(checked.size(), 0);
   std::vector<std::uint32_t> queue;
-  auto pass = [&](double factor) {
-    for (std::size_t v = 0; v < nv; ++v)
-      for (int k = 0; k < 3; ++k) x[v][k] = base[v][k] + t[v] * axis[v][k];
-    previous = t;
-    sumTriangleNormals(x, triangle, normal);  // area-weighted vertex normals
-    for (std::size_t v = 0; v < nv; ++v) {
-      const auto neighbours = ring[v];
-      if (neighbours.empty()) continue;
-      Point3 laplacian{0, 0, 0};
-      for (std::uint32_t w : neighbours)
-        for (int k = 0; k < 3; ++k) laplacian[k] += x[w][k];
-      for (int k = 0; k < 3; ++k) laplacian[k] = laplacian[k] / double(neighbours.size()) - x[v][k];
+  auto move = [&](double factor, std::size_t begin, std::size_t end) {
+    const Point3* const xs = x.data();
+    const std::uint32_t* const rs = ring.data();
+    for (std::size_t v = begin; v < end; ++v) {
+      previous[v] = t[v];
+      // The umbrella Laplacian and the area-weighted normal, the sum over the triangles
+      // (v, r_i, r_{i+1}) of (r_i - v) x (r_{i+1} - v).
+      const Point3 xv = xs[v];
+      const std::size_t first = ringStart[v] + v, last = ringStart[v + 1] + v;
+      Point3 sum{0, 0, 0}, n{0, 0, 0};
+      Point3 a = sub(xs[rs[first]], xv);
+      for (std::size_t k = first + 1; k <= last; ++k) {
+        const Point3 b = sub(xs[rs[k]], xv);
+        const Point3 tn = cross(a, b);
+        for (int i = 0; i < 3; ++i) {
+          sum[i] += a[i];
+          n[i] += tn[i];
+        }
+        a = b;
+      }
+      // The mean of the neighbours minus x, summed as offsets from x.
+      Point3 laplacian;
+      for (int i = 0; i < 3; ++i) laplacian[i] = sum[i] * inverseDegree[v];
       // Only the Laplacian's normal part moves the surface; its tangential part, projected on
       // the segment, would push the vertex off the surface. So the vertex goes where its
       // segment meets the plane through x + factor (L . n) n normal to n, unless the segment is
       // nearly tangent (then the orthogonal projection of the move on the segment).
-      const Point3& n = normal[v];
       const double nn = dot(n, n), an = dot(axis[v], n);
       double step;
       if (an * an > kMinNormalCosine2 * nn * dot(axis[v], axis[v])) step = factor * dot(laplacian, n) / an;
       else step = factor * dot(laplacian, axis[v]) * inverseLength2[v];
       t[v] = std::clamp(t[v] + step, p.epsilon, 1 - p.epsilon);
+      xNext[v] = physicalPoint(v);
     }
+  };
+  auto pass = [&](double factor) {
+    arena.execute([&] { forBlocks(nv, parallel, [&](std::size_t b, std::size_t e) { move(factor, b, e); }); });
     // The fold check: every checked cube is tested after the last change of its vertices; a
     // failing cube halves its vertices' moves (or undoes them after `halvings`) and requeues
     // the cubes of those vertices. A cube whose vertices are all back is as it was before the
     // pass, embedded, so this ends with every guarded cube embedded. A cube none of whose
     // vertices moved is as it was.
-    std::fill(halved.begin(), halved.end(), 0);
     queue.clear();
     for (std::uint32_t i = 0; i < checked.size(); ++i)
       for (std::uint32_t v : verticesOfChecked[i])
@@ -235,6 +324,7 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
           queued[i] = 1;
           break;
         }
+    if (!queue.empty()) std::fill(halved.begin(), halved.end(), 0);
     while (!queue.empty()) {
       const std::uint32_t i = queue.back();
       queue.pop_back();
@@ -246,6 +336,7 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
         moved = true;
         ++report.stepsBack;
         t[v] = ++halved[v] > p.halvings ? previous[v] : previous[v] + (t[v] - previous[v]) / 2;
+        xNext[v] = physicalPoint(v);
         for (std::uint32_t j : checkedOfVertex[v])
           if (!queued[j]) {
             queue.push_back(j);
@@ -254,6 +345,7 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
       }
       if (!moved) throw std::logic_error("smoothOnSegments: a guarded cube is not embedded at its previous state");
     }
+    x.swap(xNext);
   };
   for (int i = 0; i < p.iterations; ++i) {
     pass(p.lambda);
@@ -261,9 +353,8 @@ SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometr
   }
 
   for (std::size_t v = 0; v < nv; ++v) {
-    const Point3 q{base[v][0] + t[v] * axis[v][0], base[v][1] + t[v] * axis[v][1], base[v][2] + t[v] * axis[v][2]};
-    report.maxDisplacement = std::max(report.maxDisplacement, norm(sub(q, start[v])));
-    mesh.set_point(mesh.vertex_handle(unsigned(v)), SurfaceMesh::Point(q[0], q[1], q[2]));
+    report.maxDisplacement = std::max(report.maxDisplacement, norm(sub(x[v], points[v])));
+    points[v] = x[v];
   }
   return report;
 }

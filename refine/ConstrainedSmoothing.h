@@ -6,10 +6,14 @@
 // centre keeps its side (section 8), and no cube that was embedded stops being so.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "Geometry.h"
-#include "SurfaceMesh.h"
+#include "Surfel.h"
+#include "TriangleIntersection.h"
 
 namespace surftrack::refine {
 
@@ -19,6 +23,7 @@ struct SmoothingParameters {
   double mu = -0.73;      ///< the inflating pass's factor, with mu < -lambda < 0
   double epsilon = 1e-3;  ///< t stays in [epsilon, 1 - epsilon], epsilon in ]0, 0.5[
   int halvings = 4;       ///< step-back halvings of a vertex's move before it stays put
+  int threads = 0;        ///< threads for the passes (0: all cores); the result is the same for any
 };
 
 struct SmoothingReport {
@@ -29,13 +34,18 @@ struct SmoothingReport {
   double maxDisplacement = 0;      ///< largest vertex move, physical units
 };
 
-/// Smooths `mesh` in place. Its points are physical (`geometry` applied to index space), every
-/// vertex carries its surfel (kSurfelPropertyName) and lies on that surfel's segment.
-/// \pre mesh is a continuous analog as the converter builds it: every triangle's vertices lie on
-///      edges of one digital 3-cube.
-/// \throw std::invalid_argument for parameters out of range, a vertex off its segment, or a
-///        triangle whose vertices lie in no single cube (e.g. a decimated mesh).
-SmoothingReport smoothOnSegments(SurfaceMesh& mesh, const ImageGeometry& geometry,
-                                 const SmoothingParameters& parameters = {});
+/// Smooths the mesh of `points`, `surfels` and `triangles` in place: vertex v at points[v]
+/// (physical, `geometry` applied to index space) is the surfel surfels[v] and lies on its
+/// segment; only the points change. The one-rings come from the triangles, with no half-edge
+/// mesh.
+/// \pre the mesh is a continuous analog as the converter builds it: a closed, oriented
+///      2-manifold every triangle of which has its vertices on edges of one digital 3-cube.
+/// \throw std::invalid_argument for parameters out of range, sizes that differ, a vertex index
+///        out of range, a vertex off its segment, or a triangle whose vertices lie in no single
+///        cube (e.g. a decimated mesh); std::logic_error (requireClosedOrientedManifold,
+///        converter/SurfaceMesh.h) for triangles that are no closed, oriented 2-manifold.
+SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfels,
+                                 const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                                 const ImageGeometry& geometry, const SmoothingParameters& parameters = {});
 
 }  // namespace surftrack::refine

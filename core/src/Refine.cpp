@@ -1,5 +1,6 @@
-// smooth() and decimate() of the front door (docs/api.md): a Surface through the half-edge
-// SurfaceMesh to the refine/ algorithms and back, with the figures recomputed.
+// smooth() and decimate() of the front door (docs/api.md): a Surface to the refine/ algorithms
+// (smoothing on its arrays, decimation through the half-edge SurfaceMesh and back), with the
+// figures recomputed.
 #include "Refine.h"
 
 #include <stdexcept>
@@ -75,12 +76,14 @@ SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
   p.lambda = o.lambda;
   p.mu = o.mu;
   p.epsilon = o.epsilon;
+  p.threads = o.threads;
   SmoothReport report;
   report.volumeBefore = volumeOf(surface);
-  SurfaceMesh mesh = meshOf(surface);
-  const refine::SmoothingReport r =
-      translatingErrors([&] { return refine::smoothOnSegments(mesh, surface.geometry, p); });
-  store(mesh, surface);
+  // Smoothing moves points only: it works on the surface's arrays, with no half-edge mesh.
+  const refine::SmoothingReport r = translatingErrors([&] {
+    return refine::smoothOnSegments(surface.vertices, surface.surfels, surface.triangles, surface.geometry, p);
+  });
+  addFigures(surface);
   report.iterations = o.iterations;
   report.cubes = r.cubes;
   report.unguardedCubes = r.unguardedCubes;

@@ -184,6 +184,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
   if (smoothIterations > 0) {
     SmoothOptions so;
     so.iterations = smoothIterations;
+    so.threads = threads;
     ro.smooth = so;
   }
   if (maxError || reduction) {

@@ -176,7 +176,7 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
     vertex on its surfel's segment: "linear" (iso-value interpolation, the default for a
     level), "midpoint" (the default for a label). ``progress(stage, index, stages, surfels)``
     is called at each stage and while tracking. ``threads`` (0: all cores) runs the scan of
-    "largest" and "all" in parallel; the surface is the same for any number. ``figures=False``
+    "largest" and "all" and the smoothing in parallel; the surface is the same for any number. ``figures=False``
     skips the per-component figures (``components`` empty, ``euler`` 0). ``affine`` (a 4x4 voxel-to-world matrix, as
     nibabel's ``img.affine``) replaces spacing, origin and direction. ``smooth=N`` smooths
     with N Taubin iterations, every vertex kept on its surfel's segment (the same voxels

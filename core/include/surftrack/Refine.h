@@ -24,6 +24,7 @@ struct SmoothOptions {
   double lambda = 0.7;    ///< the strength: the shrinking pass's factor, in ]0, 1]
   double mu = -0.73;      ///< the inflating pass's factor, mu < -lambda, mu >= -1
   double epsilon = 1e-3;  ///< each vertex stays at t in [epsilon, 1 - epsilon] of its segment
+  int threads = 0;        ///< threads for the passes (0: all cores); the same result for any number
 };
 
 struct SmoothReport {
