@@ -83,7 +83,7 @@ SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
   const refine::SmoothingReport r = translatingErrors([&] {
     return refine::smoothOnSegments(surface.vertices, surface.surfels, surface.triangles, surface.geometry, p);
   });
-  addFigures(surface);
+  addFigures(surface, /*connected=*/surface.components.size() == 1);  // (the connectivity is unchanged)
   report.iterations = o.iterations;
   report.cubes = r.cubes;
   report.unguardedCubes = r.unguardedCubes;
