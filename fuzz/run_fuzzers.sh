@@ -5,6 +5,10 @@
 #
 #   fuzz/run_fuzzers.sh [seconds per target, default 30] [build directory, default ./build-fuzz]
 #
+# With SURFTRACK_FUZZ_RUNS=N each target runs N inputs from a fixed seed (SURFTRACK_FUZZ_SEED,
+# default 1) instead of for a time: the same inputs on every machine, so that a finding is the
+# code's, not the luck of one run (CI runs this way; exploring is for runs by time).
+#
 # Exit status: 0 no finding; 1 a crash, hang (> 10 s on one input), leak in surftrack code,
 # out-of-memory or sanitizer report (the reproducer is in <build>/runs/<format>/findings/,
 # replay it with <build>/fuzz_volume_header_<format> <file>); 77 skipped: no clang++ (or g++).
@@ -35,7 +39,9 @@ cmake -S "$here" -B "$build" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=cla
   { cat "$build.configure.log"; exit 1; }
 cmake --build "$build" -j"${SURFTRACK_FUZZ_JOBS:-2}" >"$build.build.log" 2>&1 || { tail -40 "$build.build.log"; exit 1; }
 built=$(date +%s)
-echo "run_fuzzers: built in $((built - start)) s; ${seconds} s per target"
+per="${seconds} s"
+[[ -z ${SURFTRACK_FUZZ_RUNS:-} ]] || per="$SURFTRACK_FUZZ_RUNS inputs (seed ${SURFTRACK_FUZZ_SEED:-1})"
+echo "run_fuzzers: built in $((built - start)) s; $per per target"
 
 export LSAN_OPTIONS="suppressions=$here/lsan.supp:print_suppressions=0"
 export ASAN_OPTIONS="abort_on_error=1:detect_leaks=1:allocator_may_return_null=1"
@@ -46,7 +52,12 @@ for f in "${formats[@]}"; do
   rm -rf "$run"
   mkdir -p "$run/corpus" "$run/findings"
   # A fresh corpus each run, grown from the seeds (kept in $run/corpus for inspection).
-  if "$build/fuzz_volume_header_$f" "$run/corpus" "$build/corpus/$f" -max_total_time="$seconds" -timeout=10 \
+  if [[ -n ${SURFTRACK_FUZZ_RUNS:-} ]]; then
+    budget=(-runs="$SURFTRACK_FUZZ_RUNS" -seed="${SURFTRACK_FUZZ_SEED:-1}")
+  else
+    budget=(-max_total_time="$seconds")
+  fi
+  if "$build/fuzz_volume_header_$f" "$run/corpus" "$build/corpus/$f" "${budget[@]}" -timeout=10 \
        -rss_limit_mb=2048 -artifact_prefix="$run/findings/" -print_final_stats=1 </dev/null >"$run/log" 2>&1; then
     result=ok
   elif [[ -n $(ls "$run/findings") ]]; then

@@ -118,14 +118,16 @@ Inflated inflateGzip(const OpenFile& file, std::uint64_t bytes, std::uint64_t al
   std::string why;
   std::shared_ptr<const void> in = file.map(0, file.size(), why);
   if (!in) in = file.read(0, file.size());
+  // (From 1 MiB on, whole 2 MiB pages, as converter/SurfaceMesh.cpp's fresh arrays.)
   constexpr std::size_t kHuge = std::size_t(1) << 21;
   const std::size_t pad = std::size_t((64 - alignedAt % 64) % 64);
-  const std::size_t total = std::size_t(bytes) + pad;
-  const std::size_t rounded = (std::max<std::size_t>(total, 1) + kHuge - 1) & ~(kHuge - 1);
-  void* p = std::aligned_alloc(kHuge, rounded);
+  const std::size_t total = std::max<std::size_t>(std::size_t(bytes) + pad, 1);
+  const std::size_t align = total >= kHuge / 2 ? kHuge : 64;
+  const std::size_t rounded = (total + align - 1) & ~(align - 1);
+  void* p = std::aligned_alloc(align, rounded);
   if (!p) throw std::bad_alloc();
   Inflated out{std::shared_ptr<void>(p, [](void* q) { std::free(q); }), static_cast<unsigned char*>(p) + pad};
-  adviseHugePages(p, rounded);
+  if (align == kHuge) adviseHugePages(p, rounded);
 
   const std::unique_ptr<libdeflate_decompressor, void (*)(libdeflate_decompressor*)> decoder(
       libdeflate_alloc_decompressor(), libdeflate_free_decompressor);

@@ -39,7 +39,7 @@ struct Inflated {
 };
 
 /// Inflates the gzip members of `file` (one or more, as gzip and bgzip write them) with
-/// libdeflate into a new buffer of exactly `bytes` bytes (2 MiB pages where offered), byte
+/// libdeflate into a new buffer of exactly `bytes` bytes (on 2 MiB pages from 1 MiB on), byte
 /// `alignedAt` of them on a 64-byte boundary. Members that hold more than `bytes` are read as
 /// readVolume reads them: the first `bytes` kept, the rest checked (inflateGzipPrefix takes
 /// over then); bytes after a member that do not start another are ignored. Throws ReadError:

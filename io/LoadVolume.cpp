@@ -268,6 +268,18 @@ LoadedVolume loadVolume(const std::string& path) {
           throw ReadError(separate->context() + ": " + e.what());
         }
       }
+      // A MetaImage's list of files: each a regular file with its part of the voxels (MetaIO
+      // reads what it cannot open into its buffer, and may crash).
+      if (!layout.listedFiles.empty()) {
+        const std::uint64_t part = layout.dataBytes() / layout.listedFiles.size();
+        for (const std::string& listed : layout.listedFiles) {
+          const std::string data = dataPath(path, listed);
+          const detail::OpenFile each(data, "cannot read " + quoted(path) + ": its listed data file " + quoted(data));
+          if (each.size() < part)
+            throw ReadError(each.context() + " has " + std::to_string(each.size()) + " bytes, fewer than the " +
+                            std::to_string(part) + " its part of the voxels needs (truncated file?)");
+        }
+      }
       // A MetaImage's compressed voxels: inflated once here, so that a corrupt stream is an
       // error (ITK 5.2's MetaIO reports none, and may never return), where MetaIO reads it —
       // CompressedDataSize bytes from the voxels' offset, or without it the whole file.

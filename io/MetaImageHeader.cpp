@@ -73,6 +73,9 @@ class Parser {
         if (first) throw HeaderError("not a MetaImage file: it does not begin with 'ObjectType = Image'");
         fail("is not 'Key = Value'");
       }
+      // MetaIO copies a key it does not know into a field name of 255 bytes (MET_InitReadField,
+      // strcpy): a longer one would overflow it.
+      if (sep >= kMaxKey) fail("has a key of more than " + std::to_string(kMaxKey - 1) + " characters");
       const std::string_view key = trim(line_.substr(0, sep));
       std::size_t v = sep;
       while (v < line_.size() && (line_[v] == '=' || line_[v] == ':' || text::isBlank(line_[v]))) ++v;
@@ -89,7 +92,10 @@ class Parser {
           throw HeaderError("not a MetaImage image: ObjectType = " + quote(value_));
         first = false;
       }
-      if (key == "ElementDataFile") return finish(next);
+      if (key == "ElementDataFile") {
+        if (value_.substr(0, 4) == "LIST" && !listComplete(next, whole)) return std::nullopt;
+        return finish(next);
+      }
       field(key);
       pos = next;
     }
@@ -183,6 +189,44 @@ class Parser {
   // (MET_StringToWordArray), each in a buffer of 80 bytes (METAIO_MAX_WORD_SIZE), and joins a
   // pattern's words back into the first one's buffer: longer words would overflow them.
   static constexpr std::size_t kMaxWord = 80;
+  static constexpr std::size_t kMaxKey = 255;
+
+  /// The files of ElementDataFile = LIST [D], as MetaIO reads them: one name per line after the
+  /// header (getline into 1024 bytes), one file for each D-dimensional block (D = NDims - 1 by
+  /// default, as MetaIO takes it). A missing, empty or overlong name would make MetaIO read a
+  /// file it cannot open into its buffer, and crash (found by fuzz/). False if the head ends
+  /// before the last name and the file is longer; the names go to listed_.
+  bool listComplete(std::size_t start, bool whole) {
+    const auto w = metaWords();
+    int fileDims = 0;
+    if (w.size() > 1) {
+      const auto d = text::toInteger(w[1]);
+      if (!d) fail("has " + quote(w[1]) + " where the dimension of the listed files is expected");
+      fileDims = int(*d);
+    }
+    const int ndims = requireNDims();
+    if (fileDims <= 0 || fileDims > ndims) fileDims = ndims - 1;
+    if (sizes_.size() != std::size_t(ndims)) fail("comes before DimSize");
+    std::int64_t files = 1;
+    for (int a = ndims; a > fileDims; --a) files *= sizes_[std::size_t(a - 1)];
+    listed_.clear();
+    std::size_t pos = start;
+    for (std::int64_t i = 0; i < files; ++i) {
+      const std::size_t eol = head_.find('\n', pos);
+      if (eol == std::string_view::npos && !whole) return false;
+      const std::size_t end = eol == std::string_view::npos ? head_.size() : eol;
+      std::string_view name = head_.substr(pos, end - pos);
+      if (!name.empty() && name.back() == '\r') name.remove_suffix(1);
+      if (pos >= head_.size() || trim(name).empty())
+        fail("lists " + std::to_string(i) + " data files, and the image needs " + std::to_string(files));
+      if (name.size() >= 1023) fail("lists a data file name of more than 1022 characters");
+      for (char c : name)
+        if (text::isControl(c)) fail("lists a data file name with a control character");
+      listed_.emplace_back(name);
+      pos = end + 1;
+    }
+    return true;
+  }
 
   std::vector<std::string_view> metaWords() {
     std::vector<std::string_view> out;
@@ -253,7 +297,7 @@ class Parser {
     if (!local) {
       layout.severalDataFiles = value_.substr(0, 4) == "LIST" || value_.find('%') != std::string_view::npos;
       if (value_.substr(0, 4) == "LIST") {
-        metaWords();
+        layout.listedFiles = listed_;
         because("its voxels are in a list of files (ElementDataFile = LIST)");
       } else if (value_.find('%') != std::string_view::npos) {
         requireFilePattern();
@@ -293,6 +337,7 @@ class Parser {
   std::string_view head_;
   std::uint64_t fileSize_;
   std::string_view line_, value_;
+  std::vector<std::string> listed_;
   std::size_t lineStart_ = 0;
   int ndims_ = 0;
   std::vector<std::int64_t> sizes_;

@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "Geometry.h"
 #include "ScalarType.h"
@@ -43,6 +44,9 @@ struct DataLayout {
   /// The voxels are in several files (a list, or numbered files): dataFile is the header's
   /// description of them, not a file name.
   bool severalDataFiles = false;
+  /// MetaImage ElementDataFile = LIST: the listed files, as the header writes them (relative
+  /// to the header's directory unless absolute), each holding an equal part of the voxels.
+  std::vector<std::string> listedFiles;
   /// For voxels that are not stored raw: at most this many bytes of voxels per stored byte
   /// (deflate expands at most 1032 times; text needs two characters a value), so that a header
   /// announcing more voxels than its data can hold is an error before a reader allocates

@@ -825,6 +825,14 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
       {"missing.mhd", metaHeader("MET_SHORT", kDims, "", "nowhere.raw"), "no such file"},
       {"nodatafile.mha", "ObjectType = Image\nNDims = 3\nDimSize = 7 5 3\nElementType = MET_SHORT\nElementDataFile =\n",
        "names no data file"},
+      // What crashed ITK's MetaIO (fuzz/): a key longer than its 255-byte field names, and a
+      // list of files with a blank, missing or short entry.
+      {"longkey.mha", "ObjectType = Image\nNDims = 3\n" + std::string(300, 'K') + " = 1\n", "more than 254 characters"},
+      {"blanklist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\n\nok.raw\n", "lists 1 data files"},
+      {"shortlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nok.raw\n", "lists 2 data files"},
+      {"missinglist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nnowhere.raw\nok.raw\n", "no such file"},
+      {"dirlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\n.\nok.raw\n", "directory"},
+      {"shortfile.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\ntiny.raw\nok.raw\n", "truncated"},
       // ITK's matrix code aborts on the infinity 1e200 * 1e200 makes.
       {"huge.mha", "ObjectType = Image\nNDims = 3\nDimSize = 7 5 3\nElementSpacing = 1e200 1e200 1e200\n"
                    "TransformMatrix = 1e200 0 0 0 1e200 0 0 0 1e200\nElementType = MET_SHORT\nElementDataFile = LOCAL\n" + data,
@@ -853,6 +861,7 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
       {"empty.nrrd", "", "empty"},
   };
   writeFile(dir / "short.raw", data.substr(3));
+  writeFile(dir / "tiny.raw", data.substr(0, 10));  // less than a slice
   ASSERT_EQ(::mkfifo((dir / "fifo.raw").c_str(), 0600), 0);  // opening it must not wait for a writer
   // NIfTI-1 headers with one field broken.
   {
