@@ -2,7 +2,8 @@
 # The checks beyond the README's test command:
 #   fuzz [seconds]  the libFuzzer target of fuzz/ (the header readers that locate voxel data),
 #                   run per format for a bounded time, seeded with the test files
-#                   (fuzz/run_fuzzers.sh; default 10 s per format). CI runs this (.ci/run).
+#                   (fuzz/run_fuzzers.sh; default 10 s per format; with SURFTRACK_FUZZ_RUNS=N,
+#                   N inputs from a fixed seed instead). CI runs this with N = 5000 (.ci/run).
 #   sanitize        the whole test suite again, in a build of its own with AddressSanitizer and
 #                   UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its
 #                   test). About 24 minutes on the 2-core machines (16 of build, 7.5 of tests): not in CI.
