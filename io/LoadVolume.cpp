@@ -61,12 +61,16 @@ constexpr Format kFormats[] = {{".mha", "mha", parseMetaImageHeader},
                                {".nhdr", "nhdr", parseNrrdHeader},
                                {".nii", "nii", parseNifti1Header}};
 
-const Format* formatOf(const std::string& path) {
+/// Whether the file name of `path` ends with `suffix` (lower case), whatever its case.
+bool hasSuffix(const std::string& path, std::string_view suffix) {
   std::string name = fs::path(path).filename().string();
   for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+const Format* formatOf(const std::string& path) {
   for (const Format& f : kFormats)
-    if (name.size() >= f.suffix.size() && name.compare(name.size() - f.suffix.size(), f.suffix.size(), f.suffix) == 0)
-      return &f;
+    if (hasSuffix(path, f.suffix)) return &f;
   return nullptr;
 }
 
@@ -175,15 +179,6 @@ std::string disagreement(const detail::ItkHeader& itk, const DataLayout& layout)
   return {};
 }
 
-constexpr std::string_view kGzippedNifti = ".nii.gz";
-
-bool isGzippedNifti(const std::string& path) {
-  std::string name = fs::path(path).filename().string();
-  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return name.size() >= kGzippedNifti.size() &&
-         name.compare(name.size() - kGzippedNifti.size(), kGzippedNifti.size(), kGzippedNifti) == 0;
-}
-
 /// A gzip'd single-file NIfTI-1 image: its header inflated and parsed first (the strict parser
 /// of a .nii, so that a malformed header is an error before ITK sees it), its geometry read by
 /// ITK as for a mapped file, then the whole file inflated once, by libdeflate, into the buffer
@@ -241,7 +236,7 @@ void LoadedVolume::advise(Access access) const {
 LoadedVolume loadVolume(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read " + quoted(path) + ": no such file");
-  if (isGzippedNifti(path) && !fs::is_directory(path, ec)) {
+  if (hasSuffix(path, ".nii.gz") && !fs::is_directory(path, ec)) {
     try {
       return loadGzippedNifti(path);
     } catch (const std::bad_alloc&) {

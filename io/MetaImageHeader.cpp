@@ -207,8 +207,11 @@ class Parser {
     const int ndims = requireNDims();
     if (fileDims <= 0 || fileDims > ndims) fileDims = ndims - 1;
     if (sizes_.size() != std::size_t(ndims)) fail("comes before DimSize");
-    std::int64_t files = 1;
-    for (int a = ndims; a > fileDims; --a) files *= sizes_[std::size_t(a - 1)];
+    std::int64_t files = 1;  // (at most one a line of the header's 1 MiB)
+    for (int a = ndims; a > fileDims; --a) {
+      if (sizes_[std::size_t(a - 1)] > std::int64_t(kMaxHeaderBytes) / files) fail("needs more listed files than its header can hold");
+      files *= sizes_[std::size_t(a - 1)];
+    }
     listed_.clear();
     std::size_t pos = start;
     for (std::int64_t i = 0; i < files; ++i) {
