@@ -26,36 +26,65 @@ std::string zlibError(const z_stream& z, int status) {
   return z.msg ? z.msg : "zlib error " + std::to_string(status);
 }
 
-}  // namespace
-
-void requireDeflated(const OpenFile& file, std::uint64_t offset, std::uint64_t length, std::uint64_t expected) {
-  if (offset > file.size() || file.size() - offset < length) corrupt(file, "the stream runs past the end of the file");
+/// zlib's inflate over bytes [offset, offset + length) of `file` (windowBits as inflateInit2
+/// takes them), the one loop of both checks and decodes here: the first `keep` bytes inflated
+/// go to `out` (nullptr: counted, not kept) and inflation stops there, unless `toEnd`, which
+/// inflates the rest into a scratch buffer and requires the last stream to end. With `members`,
+/// a stream followed by another gzip member goes on into it, as gzread does; other bytes after
+/// a stream are ignored. Returns min(keep, the bytes inflated).
+std::uint64_t inflateRange(const OpenFile& file, std::uint64_t offset, std::uint64_t length, int windowBits,
+                           unsigned char* out, std::uint64_t keep, bool toEnd, bool members) {
   z_stream z{};
-  if (inflateInit2(&z, 47) != Z_OK) corrupt(file, "zlib cannot start");
-  constexpr std::size_t kChunk = std::size_t(1) << 20;
-  std::vector<unsigned char> in(kChunk), out(kChunk);
-  std::uint64_t read = 0, inflated = 0;
-  int status = Z_OK;
-  while (status != Z_STREAM_END && inflated < expected) {
+  if (inflateInit2(&z, windowBits) != Z_OK) corrupt(file, "zlib cannot start");
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  std::vector<unsigned char> in(kChunk), scratch;
+  std::uint64_t read = 0, made = 0;
+  bool ended = false;  // the last stream read to its end
+  for (;;) {
+    const bool keeping = made < keep;
+    if (!keeping && !toEnd) break;
+    if (keeping && out) {
+      z.next_out = out + made;
+      z.avail_out = uInt(std::min<std::uint64_t>(keep - made, std::uint64_t(1) << 30));
+    } else {
+      scratch.resize(kChunk);
+      z.next_out = scratch.data();
+      z.avail_out = uInt(keeping ? std::min<std::uint64_t>(keep - made, kChunk) : kChunk);
+    }
     if (z.avail_in == 0) {
-      if (read == length) break;  // the stream ends before its end: truncated
-      const std::size_t n = file.readAt(offset + read, in.data(), std::size_t(std::min<std::uint64_t>(kChunk, length - read)));
-      if (n == 0) break;
+      const std::size_t n =
+          read < length ? file.readAt(offset + read, in.data(), std::size_t(std::min<std::uint64_t>(kChunk, length - read))) : 0;
+      if (n == 0) break;  // the range ends (inside a stream, unless `ended`)
       read += n;
       z.next_in = in.data();
       z.avail_in = uInt(n);
     }
-    z.next_out = out.data();
-    z.avail_out = uInt(out.size());
-    status = inflate(&z, Z_NO_FLUSH);
-    inflated += out.size() - z.avail_out;
-    if (status != Z_OK && status != Z_STREAM_END && !(status == Z_BUF_ERROR && z.avail_in == 0)) {
+    const uInt room = z.avail_out;
+    const int status = inflate(&z, Z_NO_FLUSH);
+    if (keeping) made += room - z.avail_out;
+    ended = status == Z_STREAM_END;
+    if (ended) {
+      const std::uint64_t at = read - z.avail_in;  // the byte after the stream
+      unsigned char magic[2] = {0, 0};
+      if (!members || at + 2 > length || file.readAt(offset + at, magic, 2) < 2 || magic[0] != 0x1f || magic[1] != 0x8b)
+        break;
+      inflateReset(&z);
+    } else if (status != Z_OK && !(status == Z_BUF_ERROR && z.avail_in == 0)) {
       const std::string why = zlibError(z, status);
       inflateEnd(&z);
       corrupt(file, why);
     }
   }
   inflateEnd(&z);
+  if (toEnd && !ended) corrupt(file, "the gzip stream is cut short (truncated file?)");
+  return made;
+}
+
+}  // namespace
+
+void requireDeflated(const OpenFile& file, std::uint64_t offset, std::uint64_t length, std::uint64_t expected) {
+  if (offset > file.size() || file.size() - offset < length) corrupt(file, "the stream runs past the end of the file");
+  const std::uint64_t inflated = inflateRange(file, offset, length, 47, nullptr, expected, false, false);
   if (inflated < expected)
     corrupt(file, "it inflates to " + std::to_string(inflated) + " bytes, fewer than the " + std::to_string(expected) +
                       " bytes of voxels (truncated file?)");
@@ -67,48 +96,7 @@ bool isGzip(const OpenFile& file) {
 }
 
 std::size_t inflateGzipPrefix(const OpenFile& file, unsigned char* out, std::size_t bytes, bool checkRest) {
-  z_stream z{};
-  if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK) corrupt(file, "zlib cannot start");
-  std::vector<unsigned char> in(std::size_t(1) << 16), scratch;
-  std::uint64_t read = 0;
-  std::size_t made = 0;
-  bool ended = false;  // the last member read to its end
-  for (;;) {
-    const bool discarding = made == bytes;  // the bytes after the first `bytes`, if checkRest
-    if (discarding) {
-      if (!checkRest) break;
-      scratch.resize(std::size_t(1) << 16);
-      z.next_out = scratch.data();
-      z.avail_out = uInt(scratch.size());
-    } else {
-      z.next_out = out + made;
-      z.avail_out = uInt(std::min<std::size_t>(bytes - made, std::size_t(1) << 30));
-    }
-    if (z.avail_in == 0) {
-      const std::size_t n = file.readAt(read, in.data(), in.size());
-      if (n == 0) break;  // the file ends
-      read += n;
-      z.next_in = in.data();
-      z.avail_in = uInt(n);
-    }
-    const uInt room = z.avail_out;
-    const int status = inflate(&z, Z_NO_FLUSH);
-    if (!discarding) made += room - z.avail_out;
-    ended = status == Z_STREAM_END;
-    if (ended) {
-      // Another member follows, or bytes that gzread ignores.
-      unsigned char magic[2] = {0, 0};
-      if (file.readAt(read - z.avail_in, magic, 2) < 2 || magic[0] != 0x1f || magic[1] != 0x8b) break;
-      inflateReset(&z);
-    } else if (status != Z_OK && !(status == Z_BUF_ERROR && z.avail_in == 0)) {
-      const std::string why = zlibError(z, status);
-      inflateEnd(&z);
-      corrupt(file, why);
-    }
-  }
-  inflateEnd(&z);
-  if (checkRest && !ended) corrupt(file, "the gzip stream is cut short (truncated file?)");
-  return made;
+  return std::size_t(inflateRange(file, 0, file.size(), 16 + MAX_WBITS, out, bytes, checkRest, /*members=*/true));
 }
 
 Inflated inflateGzip(const OpenFile& file, std::uint64_t bytes, std::uint64_t alignedAt) {
