@@ -9,7 +9,10 @@ on the same mesh: vtkWindowedSincPolyDataFilter with the same number of iteratio
 reduction. Reports for each result the RMS of |x - c| - R over the vertices (the sphere only),
 the enclosed volume against the extracted mesh's, the times, and, from surftrack_mesh_check
 (CGAL, tests/mesh_check.cpp; --skip-checks leaves it out), closedness, genus and
-self-intersecting triangle pairs. Times are wall and CPU seconds of the calls alone (the
+self-intersecting triangle pairs. With --floor it also runs bench_decimation_floor on the mesh
+both tools decimate: OpenMesh's Decimater with the quadric alone, then with the link condition
+alone, then decimateSafely, each to the same triangle count (what the guards cost, against VTK's
+figure of the same run). Times are wall and CPU seconds of the calls alone (the
 process's CPU time, all threads, for surftrack's smoothing and for VTK; the thread's for
 surftrack's decimation, which runs on one). Both smoothings get the same thread count (--threads,
 default 2: surftrack's SmoothOptions::threads, VTK's vtkSMPTools, whose backend is TBB in
@@ -104,6 +107,8 @@ def main():
     ap.add_argument("--input", help="a volume file instead of the sphere (its largest boundary)")
     ap.add_argument("--iso", type=float, default=0.0, help="the iso-value (threshold) for --input")
     ap.add_argument("--skip-checks", action="store_true", help="no CGAL checks (large meshes)")
+    ap.add_argument("--floor", action="store_true",
+                    help="also time OpenMesh's decimation without the guards on the same mesh (bench_decimation_floor)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     bench = os.path.join(a.build, "bench", "bench_refine")
@@ -189,6 +194,16 @@ def main():
                ["midpoint (terraced)", "surftrack smooth()", "VTK windowed sinc", "surftrack decimate()"], a.png,
                centre, radius)
         print("picture:", a.png)
+    if a.floor:
+        floor = json.loads(subprocess.run(
+            [os.path.join(a.build, "bench", "bench_decimation_floor"), "--input",
+             os.path.join(a.out, "sphere-smoothed.ply" if smoothing else "sphere-midpoint.ply"),
+             "--reduce", str(a.reduce), "--max-error", str(a.max_error)],
+            check=True, capture_output=True, text=True).stdout)
+        print(f"decimation of the same mesh to {floor['target']} triangles, CPU s (median of 3): "
+              f"OpenMesh quadric alone {floor['openmesh']['cpu']:.3f}, with the link condition "
+              f"{floor['link']['cpu']:.3f}, decimateSafely {floor['safe']['cpu']:.3f}; "
+              f"VTK quadric {quadric_cpu:.3f}")
     return 0
 
 

@@ -274,43 +274,56 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   std::vector<int> halved(nv);
   std::vector<char> queued(checked.size(), 0);
   std::vector<std::uint32_t> queue;
-  auto move = [&](double factor, std::size_t begin, std::size_t end) {
+  // Each vertex's step per unit of Laplacian, t += factor (L . w): w = n / (a . n) to move to
+  // where the segment meets the plane through x + factor (L . n) n normal to n, or w = a / |a|^2
+  // (the orthogonal projection of the move on the segment) where the segment is nearly tangent.
+  // Only the Laplacian's normal part moves the surface; its tangential part, projected on the
+  // segment, would push the vertex off the surface. The normals are those of the iteration's
+  // start, shared by its two passes (section 8).
+  std::vector<Point3> stepOf(nv);
+  auto move = [&](double factor, bool newNormals, std::size_t begin, std::size_t end) {
     const Point3* const xs = x.data();
     const std::uint32_t* const rs = ring.data();
     for (std::size_t v = begin; v < end; ++v) {
       previous[v] = t[v];
-      // The umbrella Laplacian and the area-weighted normal, the sum over the triangles
-      // (v, r_i, r_{i+1}) of (r_i - v) x (r_{i+1} - v).
       const Point3 xv = xs[v];
       const std::size_t first = ringStart[v] + v, last = ringStart[v + 1] + v;
-      Point3 sum{0, 0, 0}, n{0, 0, 0};
-      Point3 a = sub(xs[rs[first]], xv);
-      for (std::size_t k = first + 1; k <= last; ++k) {
-        const Point3 b = sub(xs[rs[k]], xv);
-        const Point3 tn = cross(a, b);
-        for (int i = 0; i < 3; ++i) {
-          sum[i] += a[i];
-          n[i] += tn[i];
+      // The umbrella Laplacian, the mean of the neighbours minus x (summed as offsets from x),
+      // and with new normals the area-weighted normal, the sum over the triangles
+      // (v, r_i, r_{i+1}) of (r_i - v) x (r_{i+1} - v).
+      Point3 sum{0, 0, 0};
+      if (newNormals) {
+        Point3 n{0, 0, 0};
+        Point3 a = sub(xs[rs[first]], xv);
+        for (std::size_t k = first + 1; k <= last; ++k) {
+          const Point3 b = sub(xs[rs[k]], xv);
+          const Point3 tn = cross(a, b);
+          for (int i = 0; i < 3; ++i) {
+            sum[i] += a[i];
+            n[i] += tn[i];
+          }
+          a = b;
         }
-        a = b;
+        const double nn = dot(n, n), an = dot(axis[v], n);
+        if (an * an > kMinNormalCosine2 * nn * dot(axis[v], axis[v]))
+          for (int i = 0; i < 3; ++i) stepOf[v][i] = n[i] / an;
+        else
+          for (int i = 0; i < 3; ++i) stepOf[v][i] = axis[v][i] * inverseLength2[v];
+      } else {
+        for (std::size_t k = first; k < last; ++k) {
+          const Point3& r = xs[rs[k]];
+          for (int i = 0; i < 3; ++i) sum[i] += r[i] - xv[i];
+        }
       }
-      // The mean of the neighbours minus x, summed as offsets from x.
       Point3 laplacian;
       for (int i = 0; i < 3; ++i) laplacian[i] = sum[i] * inverseDegree[v];
-      // Only the Laplacian's normal part moves the surface; its tangential part, projected on
-      // the segment, would push the vertex off the surface. So the vertex goes where its
-      // segment meets the plane through x + factor (L . n) n normal to n, unless the segment is
-      // nearly tangent (then the orthogonal projection of the move on the segment).
-      const double nn = dot(n, n), an = dot(axis[v], n);
-      double step;
-      if (an * an > kMinNormalCosine2 * nn * dot(axis[v], axis[v])) step = factor * dot(laplacian, n) / an;
-      else step = factor * dot(laplacian, axis[v]) * inverseLength2[v];
-      t[v] = std::clamp(t[v] + step, p.epsilon, 1 - p.epsilon);
+      t[v] = std::clamp(t[v] + factor * dot(laplacian, stepOf[v]), p.epsilon, 1 - p.epsilon);
       xNext[v] = physicalPoint(v);
     }
   };
-  auto pass = [&](double factor) {
-    arena.execute([&] { forBlocks(nv, parallel, [&](std::size_t b, std::size_t e) { move(factor, b, e); }); });
+  auto pass = [&](double factor, bool newNormals) {
+    arena.execute(
+        [&] { forBlocks(nv, parallel, [&](std::size_t b, std::size_t e) { move(factor, newNormals, b, e); }); });
     // The fold check: every checked cube is tested after the last change of its vertices; a
     // failing cube halves its vertices' moves (or undoes them after `halvings`) and requeues
     // the cubes of those vertices. A cube whose vertices are all back is as it was before the
@@ -348,8 +361,8 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     x.swap(xNext);
   };
   for (int i = 0; i < p.iterations; ++i) {
-    pass(p.lambda);
-    pass(p.mu);
+    pass(p.lambda, true);
+    pass(p.mu, false);
   }
 
   for (std::size_t v = 0; v < nv; ++v) {
