@@ -4,7 +4,6 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
-#include <unordered_map>
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
@@ -16,6 +15,7 @@
 #include "DigitalCube.h"
 #include "FoldCertificate.h"
 #include "SurfaceMesh.h"
+#include "TrianglesByCube.h"
 
 namespace surftrack::refine {
 
@@ -36,14 +36,6 @@ void requireParameters(const SmoothingParameters& p) {
   else return;
   throw std::invalid_argument(msg.str());
 }
-
-/// Compressed lists: the items of list i are items[start[i] .. start[i + 1]).
-struct Lists {
-  std::vector<std::uint32_t> start, items;
-  std::span<const std::uint32_t> operator[](std::size_t i) const {
-    return {items.data() + start[i], items.data() + start[i + 1]};
-  }
-};
 
 /// Calls body(begin, end) over blocks of [0, n): on this thread for one thread or a small n,
 /// else in parallel. The bodies here write only their own items, from data no block writes,
@@ -90,18 +82,16 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   tbb::task_arena arena(p.threads > 0 ? std::min(p.threads, tbb::info::default_concurrency())
                                       : tbb::task_arena::automatic);
 
-  // Each vertex's segment in physical space, P(c) + t (P(d) - P(c)) (toPhysical is affine),
-  // and in index space, c + t (d - c), where the fold check works.
-  std::vector<Point3> base(nv), axis(nv), indexBase(nv), indexAxis(nv);
+  // Each vertex's segment in physical space, P(c) + t (P(d) - P(c)) (toPhysical is affine);
+  // the fold check works in index space, on c + t (d - c).
+  std::vector<Point3> base(nv), axis(nv);
   std::vector<double> inverseLength2(nv), t(nv);
   std::vector<char> offSegment(nv, 0);
   arena.execute([&] {
     forBlocks(nv, parallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
         const Voxel c = surfel[v].inside(), d = surfel[v].outside();
-        indexBase[v] = {double(c.x), double(c.y), double(c.z)};
-        indexAxis[v] = {double(d.x - c.x), double(d.y - c.y), double(d.z - c.z)};
-        base[v] = geometry.toPhysical(indexBase[v]);
+        base[v] = geometry.toPhysical({double(c.x), double(c.y), double(c.z)});
         axis[v] = sub(geometry.toPhysical({double(d.x), double(d.y), double(d.z)}), base[v]);
         inverseLength2[v] = 1.0 / dot(axis[v], axis[v]);
         const Point3 r = sub(points[v], base[v]);
@@ -120,46 +110,42 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     throw std::invalid_argument(msg.str());
   }
   auto indexPoint = [&](std::uint32_t v) {
-    return Point3{indexBase[v][0] + t[v] * indexAxis[v][0], indexBase[v][1] + t[v] * indexAxis[v][1],
-                  indexBase[v][2] + t[v] * indexAxis[v][2]};
+    const Voxel c = surfel[v].inside(), d = surfel[v].outside();
+    return Point3{c.x + t[v] * (d.x - c.x), c.y + t[v] * (d.y - c.y), c.z + t[v] * (d.z - c.z)};
   };
   auto physicalPoint = [&](std::size_t v) {
     return Point3{base[v][0] + t[v] * axis[v][0], base[v][1] + t[v] * axis[v][1], base[v][2] + t[v] * axis[v][2]};
   };
 
   // Triangles by digital 3-cube (section 8: each has one), with the cube edges of their
-  // vertices and their reference normals (in index space at the midpoint mapping). The cubes
-  // are numbered in the order of their first triangles.
-  std::vector<std::optional<Voxel>> cubeOf(nf);
+  // vertices. The cubes are numbered in the order of their first triangles.
+  std::vector<Voxel> cubeOf(nf);
   std::vector<CubeEdges> edgesOfFace(nf);
-  std::vector<Point3> reference(nf);
+  std::vector<char> inNoCube(nf, 0);
   arena.execute([&] {
     forBlocks(nf, parallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t f = begin; f < end; ++f) {
         const auto& tr = triangle[f];
-        cubeOf[f] = cubeOfTriangle(surfel[tr[0]], surfel[tr[1]], surfel[tr[2]]);
-        if (!cubeOf[f]) continue;
-        for (int j = 0; j < 3; ++j) edgesOfFace[f][j] = std::uint8_t(cube::edgeOf(*cubeOf[f], surfel[tr[j]]));
-        reference[f] = triangleNormal({pointOnSurfel(surfel[tr[0]], 0.5), pointOnSurfel(surfel[tr[1]], 0.5),
-                                       pointOnSurfel(surfel[tr[2]], 0.5)});
+        const std::optional<Voxel> m = cubeOfTriangle(surfel[tr[0]], surfel[tr[1]], surfel[tr[2]]);
+        if (!m) {
+          inNoCube[f] = 1;
+          continue;
+        }
+        cubeOf[f] = *m;
+        for (int j = 0; j < 3; ++j) edgesOfFace[f][j] = std::uint8_t(cube::edgeOf(*m, surfel[tr[j]]));
       }
     });
   });
-  std::vector<std::uint32_t> cubeOfFace(nf);
-  std::unordered_map<Voxel, std::uint32_t> cubeIndex;  // std::hash<Voxel>: lib/Voxel.h
-  cubeIndex.reserve(nf);
-  for (std::size_t f = 0; f < nf; ++f) {
-    if (!cubeOf[f]) {
-      std::ostringstream msg;
-      msg << "triangle " << f << " has its vertices in no single digital 3-cube: constrained smoothing "
-          << "needs the continuous analog itself (smooth before decimating)";
-      throw std::invalid_argument(msg.str());
-    }
-    cubeOfFace[f] = cubeIndex.try_emplace(*cubeOf[f], std::uint32_t(cubeIndex.size())).first->second;
+  if (const auto bad = std::find(inNoCube.begin(), inNoCube.end(), 1); bad != inNoCube.end()) {
+    std::ostringstream msg;
+    msg << "triangle " << (bad - inNoCube.begin()) << " has its vertices in no single digital 3-cube: constrained "
+        << "smoothing needs the continuous analog itself (smooth before decimating)";
+    throw std::invalid_argument(msg.str());
   }
-  const std::size_t nc = cubeIndex.size();
+  const TrianglesByCube byCube = groupTrianglesByCube(cubeOf);
+  const Lists& facesOfCube = byCube.trianglesOfCube;
+  const std::size_t nc = facesOfCube.size();
   report.cubes = nc;
-  const Lists facesOfCube = invert(cubeOfFace, nc);
   // What the fold check of each cube must test in a pass: its triangles and pairs of triangles
   // without a certificate (FoldCertificate.h), single triangles first (the pair test needs
   // non-degenerate triangles). A cube with none is embedded at every position.
@@ -179,11 +165,14 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
           items.push_back({faces[i], faces[j]});
     itemStart[c + 1] = std::uint32_t(items.size());
   }
+  // A triangle of a cube at the current positions, in index space, with its reference normal
+  // (its normal at the midpoint mapping).
   auto cubeTriangle = [&](std::uint32_t f) {
     CubeTriangle ct;
     ct.vertex = triangle[f];
     for (int k = 0; k < 3; ++k) ct.point[k] = indexPoint(ct.vertex[k]);
-    ct.reference = reference[f];
+    ct.reference = triangleNormal({pointOnSurfel(surfel[ct.vertex[0]], 0.5), pointOnSurfel(surfel[ct.vertex[1]], 0.5),
+                                   pointOnSurfel(surfel[ct.vertex[2]], 0.5)});
     return ct;
   };
   auto embedded = [&](std::uint32_t c) {

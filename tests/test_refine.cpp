@@ -12,6 +12,7 @@
 #include <cmath>
 #include <optional>
 #include <random>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -24,6 +25,7 @@
 #include "Image.h"
 #include "PairTestName.h"
 #include "Phantoms.h"
+#include "TrianglesByCube.h"
 
 using namespace surftrack;
 namespace ck = surftrack::checks;
@@ -476,4 +478,41 @@ TEST(RefineSurface, SmoothsThenDecimatesAsTheTwoCalls) {
   const RefineReport none = refineSurface(three, {});
   EXPECT_FALSE(none.smooth || none.decimate);
   EXPECT_EQ(three.vertices, extracted.vertices);
+}
+
+// groupTrianglesByCube (the fold check's grouping, refine/TrianglesByCube.h) against a std::map
+// of the corners: the same groups, numbered in the order of their first triangles, each listing
+// its triangles in increasing order; corners near together (one packed key, the radix sort),
+// negative ones, and ones too far apart for a 64-bit key (the comparison sort).
+TEST(TrianglesByCube, GroupsAsAMapOfTheCornersDoes) {
+  std::mt19937 rng(20261202);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int spread = trial % 3 == 0 ? 3 : trial % 3 == 1 ? 1000 : (1 << 30);
+    std::uniform_int_distribution<int> coordinate(-spread, spread);
+    const std::size_t n = std::size_t(rng() % 2000);
+    std::vector<Voxel> corner(n);
+    for (auto& c : corner) {
+      // Repeat earlier corners often, so that groups have several triangles.
+      if (!corner.empty() && &c != corner.data() && rng() % 2)
+        c = corner[rng() % std::size_t(&c - corner.data())];
+      else
+        c = {coordinate(rng), coordinate(rng), coordinate(rng)};
+    }
+    std::map<std::tuple<int, int, int>, std::uint32_t> number;
+    std::vector<std::vector<std::uint32_t>> members;
+    std::vector<std::uint32_t> expected(n);
+    for (std::size_t f = 0; f < n; ++f) {
+      const auto [it, added] = number.try_emplace({corner[f].x, corner[f].y, corner[f].z}, std::uint32_t(members.size()));
+      if (added) members.emplace_back();
+      expected[f] = it->second;
+      members[it->second].push_back(std::uint32_t(f));
+    }
+    const refine::TrianglesByCube got = refine::groupTrianglesByCube(corner);
+    ASSERT_EQ(got.cubeOfTriangle, expected) << "trial " << trial;
+    ASSERT_EQ(got.trianglesOfCube.size(), members.size()) << "trial " << trial;
+    for (std::size_t c = 0; c < members.size(); ++c) {
+      const auto list = got.trianglesOfCube[c];
+      ASSERT_EQ(std::vector<std::uint32_t>(list.begin(), list.end()), members[c]) << "trial " << trial << " cube " << c;
+    }
+  }
 }
