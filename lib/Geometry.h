@@ -39,6 +39,15 @@ struct ImageGeometry {
     return p;
   }
 
+  /// Maps an index-space displacement to physical space: the linear part of toPhysical,
+  /// toPhysical(i + offset) - toPhysical(i) without the rounding of the difference.
+  std::array<double, 3> toPhysicalOffset(const std::array<double, 3>& offset) const {
+    std::array<double, 3> p{0, 0, 0};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) p[r] += direction[r][c] * spacing[c] * offset[c];
+    return p;
+  }
+
   /// The inverse of toPhysical: the continuous index of a physical point. Throws
   /// std::invalid_argument if direction * diag(spacing) is singular.
   std::array<double, 3> toIndex(const std::array<double, 3>& point) const {

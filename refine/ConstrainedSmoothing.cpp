@@ -82,24 +82,40 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   tbb::task_arena arena(p.threads > 0 ? std::min(p.threads, tbb::info::default_concurrency())
                                       : tbb::task_arena::automatic);
 
-  // Each vertex's segment in physical space, P(c) + t (P(d) - P(c)) (toPhysical is affine);
-  // the fold check works in index space, on c + t (d - c).
-  std::vector<Point3> base(nv), axis(nv);
-  std::vector<double> inverseLength2(nv), t(nv);
+  // Each vertex's segment in physical space, P(c) + t a with a = P(d) - P(c) (P = toPhysical
+  // is affine): a is the image of the surfel's direction d - c, one of the six unit vectors,
+  // so a vertex's segment is its surfel's 1-voxel and direction, and the passes read one byte
+  // for its axis. The fold check works in index space, on c + t (d - c). x holds the points.
+  std::array<Point3, 6> axisOf;
+  std::array<double, 6> inverseLength2Of;
+  for (Direction n = 0; n < 6; ++n) {
+    const Voxel u = unitVector(n);
+    axisOf[n] = geometry.toPhysicalOffset({double(u.x), double(u.y), double(u.z)});
+    inverseLength2Of[n] = 1.0 / dot(axisOf[n], axisOf[n]);
+  }
+  auto physicalPoint = [&](std::size_t v, double tv) {
+    const Voxel c = surfel[v].inside();
+    const Point3 b = geometry.toPhysical({double(c.x), double(c.y), double(c.z)});
+    const Point3& a = axisOf[surfel[v].n];
+    return Point3{b[0] + tv * a[0], b[1] + tv * a[1], b[2] + tv * a[2]};
+  };
+  std::vector<Direction> direction(nv);
+  std::vector<double> t(nv);
+  std::vector<Point3> x(nv);
   std::vector<char> offSegment(nv, 0);
   arena.execute([&] {
     forBlocks(nv, parallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
-        const Voxel c = surfel[v].inside(), d = surfel[v].outside();
-        base[v] = geometry.toPhysical({double(c.x), double(c.y), double(c.z)});
-        axis[v] = sub(geometry.toPhysical({double(d.x), double(d.y), double(d.z)}), base[v]);
-        inverseLength2[v] = 1.0 / dot(axis[v], axis[v]);
-        const Point3 r = sub(points[v], base[v]);
-        const double tv = dot(r, axis[v]) * inverseLength2[v];
+        direction[v] = surfel[v].n;
+        const Point3 base = physicalPoint(v, 0);
+        const Point3& a = axisOf[direction[v]];
+        const Point3 r = sub(points[v], base);
+        const double tv = dot(r, a) * inverseLength2Of[direction[v]];
         double off = 0;
-        for (int k = 0; k < 3; ++k) off = std::max(off, std::abs(r[k] - tv * axis[v][k]));
-        offSegment[v] = !(tv > 0 && tv < 1) || off > 1e-6 * norm(axis[v]);
+        for (int k = 0; k < 3; ++k) off = std::max(off, std::abs(r[k] - tv * a[k]));
+        offSegment[v] = !(tv > 0 && tv < 1) || off > 1e-6 * norm(a);
         t[v] = std::clamp(tv, p.epsilon, 1 - p.epsilon);
+        x[v] = physicalPoint(v, t[v]);
       }
     });
   });
@@ -112,9 +128,6 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   auto indexPoint = [&](std::uint32_t v) {
     const Voxel c = surfel[v].inside(), d = surfel[v].outside();
     return Point3{c.x + t[v] * (d.x - c.x), c.y + t[v] * (d.y - c.y), c.z + t[v] * (d.z - c.z)};
-  };
-  auto physicalPoint = [&](std::size_t v) {
-    return Point3{base[v][0] + t[v] * axis[v][0], base[v][1] + t[v] * axis[v][1], base[v][2] + t[v] * axis[v][2]};
   };
 
   // Triangles by digital 3-cube (section 8: each has one), with the cube edges of their
@@ -213,6 +226,9 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     for (std::uint32_t& k : l.items) k = cubeOfChecked[k];
     return l;
   }();
+  std::vector<std::uint32_t> checkedVertices;  // the vertices of the checked cubes
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (!checkedOfVertex[v].empty()) checkedVertices.push_back(v);
   // Each vertex's one-ring in cyclic order r_0 .. r_{k-1}, its triangles being (v, r_i,
   // r_{i+1}) (indices mod k): in a closed, oriented manifold whose every vertex has a single fan
   // (requireClosedOrientedManifold) the triangle (v, b, c) is followed around v by the one of
@@ -226,7 +242,6 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   // Each ring is stored closed, r_0 .. r_{k-1} r_0, at ringStart[v] + v, so that the walk over
   // its triangles has no wrap-around test.
   std::vector<std::uint32_t> ring(3 * nf + nv);
-  std::vector<double> inverseDegree(nv);  // the Laplacian's weight, a product in the passes
   {
     // First each corner's (next, previous) pair, in triangle order, then the chains.
     std::vector<std::array<std::uint32_t, 2>> corner(3 * nf);
@@ -237,7 +252,6 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
       forBlocks(nv, parallel, [&](std::size_t begin, std::size_t end) {
         for (std::size_t v = begin; v < end; ++v) {
           const std::uint32_t first = ringStart[v], last = ringStart[v + 1];
-          inverseDegree[v] = 1.0 / double(last - first);
           std::uint32_t b = corner[first][0], c = corner[first][1];
           for (std::uint32_t k = first; k < last; ++k) {
             ring[k + v] = b;
@@ -255,11 +269,12 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   }
 
   // The passes are Jacobi updates: every vertex reads the points x of the pass's start and
-  // writes its own t, previous and next point alone, so a pass's result does not depend on the
-  // order of the vertices or on the thread count.
+  // writes its own t and next point alone, so a pass's result does not depend on the order of
+  // the vertices or on the thread count. A vertex moves along its axis by the change of its t;
+  // the final points are computed from t. The fold check keeps the t of the pass's start of the
+  // vertices it may put back (`previous`, of the checked cubes' vertices alone).
   std::vector<double> previous(nv);
-  std::vector<Point3> x(nv), xNext(nv);
-  for (std::size_t v = 0; v < nv; ++v) x[v] = physicalPoint(v);
+  std::vector<Point3> xNext(nv);
   std::vector<int> halved(nv);
   std::vector<char> queued(checked.size(), 0);
   std::vector<std::uint32_t> queue;
@@ -268,14 +283,15 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   // (the orthogonal projection of the move on the segment) where the segment is nearly tangent.
   // Only the Laplacian's normal part moves the surface; its tangential part, projected on the
   // segment, would push the vertex off the surface. The normals are those of the iteration's
-  // start, shared by its two passes (section 8).
+  // start, shared by its two passes (section 8). stepOf holds w / degree, to apply to the sum of
+  // the neighbours' offsets.
   std::vector<Point3> stepOf(nv);
   auto move = [&](double factor, bool newNormals, std::size_t begin, std::size_t end) {
     const Point3* const xs = x.data();
     const std::uint32_t* const rs = ring.data();
     for (std::size_t v = begin; v < end; ++v) {
-      previous[v] = t[v];
       const Point3 xv = xs[v];
+      const Point3& axis = axisOf[direction[v]];
       const std::size_t first = ringStart[v] + v, last = ringStart[v + 1] + v;
       // The umbrella Laplacian, the mean of the neighbours minus x (summed as offsets from x),
       // and with new normals the area-weighted normal, the sum over the triangles
@@ -293,24 +309,25 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
           }
           a = b;
         }
-        const double nn = dot(n, n), an = dot(axis[v], n);
-        if (an * an > kMinNormalCosine2 * nn * dot(axis[v], axis[v]))
-          for (int i = 0; i < 3; ++i) stepOf[v][i] = n[i] / an;
+        const double nn = dot(n, n), an = dot(axis, n), inverseDegree = 1.0 / double(last - first);
+        if (an * an > kMinNormalCosine2 * nn * dot(axis, axis))
+          for (int i = 0; i < 3; ++i) stepOf[v][i] = n[i] * (inverseDegree / an);
         else
-          for (int i = 0; i < 3; ++i) stepOf[v][i] = axis[v][i] * inverseLength2[v];
+          for (int i = 0; i < 3; ++i) stepOf[v][i] = axis[i] * (inverseLength2Of[direction[v]] * inverseDegree);
       } else {
         for (std::size_t k = first; k < last; ++k) {
           const Point3& r = xs[rs[k]];
           for (int i = 0; i < 3; ++i) sum[i] += r[i] - xv[i];
         }
       }
-      Point3 laplacian;
-      for (int i = 0; i < 3; ++i) laplacian[i] = sum[i] * inverseDegree[v];
-      t[v] = std::clamp(t[v] + factor * dot(laplacian, stepOf[v]), p.epsilon, 1 - p.epsilon);
-      xNext[v] = physicalPoint(v);
+      const double before = t[v];
+      t[v] = std::clamp(before + factor * dot(sum, stepOf[v]), p.epsilon, 1 - p.epsilon);
+      const double dt = t[v] - before;
+      xNext[v] = {xv[0] + dt * axis[0], xv[1] + dt * axis[1], xv[2] + dt * axis[2]};
     }
   };
   auto pass = [&](double factor, bool newNormals) {
+    for (std::uint32_t v : checkedVertices) previous[v] = t[v];
     arena.execute(
         [&] { forBlocks(nv, parallel, [&](std::size_t b, std::size_t e) { move(factor, newNormals, b, e); }); });
     // The fold check: every checked cube is tested after the last change of its vertices; a
@@ -326,7 +343,8 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
           queued[i] = 1;
           break;
         }
-    if (!queue.empty()) std::fill(halved.begin(), halved.end(), 0);
+    if (!queue.empty())
+      for (std::uint32_t v : checkedVertices) halved[v] = 0;
     while (!queue.empty()) {
       const std::uint32_t i = queue.back();
       queue.pop_back();
@@ -338,7 +356,9 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
         moved = true;
         ++report.stepsBack;
         t[v] = ++halved[v] > p.halvings ? previous[v] : previous[v] + (t[v] - previous[v]) / 2;
-        xNext[v] = physicalPoint(v);
+        const double dt = t[v] - previous[v];
+        const Point3& axis = axisOf[direction[v]];
+        xNext[v] = {x[v][0] + dt * axis[0], x[v][1] + dt * axis[1], x[v][2] + dt * axis[2]};
         for (std::uint32_t j : checkedOfVertex[v])
           if (!queued[j]) {
             queue.push_back(j);
@@ -355,8 +375,9 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   }
 
   for (std::size_t v = 0; v < nv; ++v) {
-    report.maxDisplacement = std::max(report.maxDisplacement, norm(sub(x[v], points[v])));
-    points[v] = x[v];
+    const Point3 q = physicalPoint(v, t[v]);
+    report.maxDisplacement = std::max(report.maxDisplacement, norm(sub(q, points[v])));
+    points[v] = q;
   }
   return report;
 }
