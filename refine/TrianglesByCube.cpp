@@ -4,6 +4,8 @@
 #include <array>
 #include <bit>
 #include <utility>
+
+#include "HugePages.h"
 #include <tuple>
 
 namespace surftrack::refine {
@@ -20,7 +22,8 @@ struct Record {
 std::vector<Record> sortByKey(std::vector<Record> in, int bits) {
   constexpr int kDigit = 11;
   constexpr std::size_t kBuckets = std::size_t(1) << kDigit;
-  std::vector<Record> out(in.size());
+  std::vector<Record> out;
+  resizeHugePages(out, in.size());
   std::array<std::uint32_t, kBuckets> count;
   for (int shift = 0; shift < bits; shift += kDigit) {
     count.fill(0);
@@ -38,7 +41,9 @@ std::vector<Record> sortByKey(std::vector<Record> in, int bits) {
 TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
   const std::size_t n = cube.size();
   TrianglesByCube out;
-  out.cubeOfTriangle.resize(n);
+  // The arrays as large as the input are written once, front to back: huge pages
+  // (lib/HugePages.h).
+  resizeHugePages(out.cubeOfTriangle, n);
   out.trianglesOfCube.start.assign(1, 0);
   if (n == 0) return out;
 
@@ -51,7 +56,8 @@ TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
     }
   std::array<int, 3> width{};
   for (int k = 0; k < 3; ++k) width[k] = int(std::bit_width(std::uint64_t(std::int64_t(hi[k]) - lo[k])));
-  std::vector<Record> records(n);
+  std::vector<Record> records;
+  resizeHugePages(records, n);
   std::vector<Record> sorted;
   if (width[0] + width[1] + width[2] <= 64) {
     for (std::size_t f = 0; f < n; ++f) {
@@ -73,7 +79,8 @@ TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
   }
 
   // Groups in key order, then renumbered by their first (least) triangle.
-  std::vector<std::uint32_t> groupOf(n), firstOfGroup;
+  std::vector<std::uint32_t> groupOf, firstOfGroup;
+  resizeHugePages(groupOf, n);
   for (std::size_t i = 0; i < n; ++i) {
     if (i == 0 || sorted[i].key != sorted[i - 1].key)
       firstOfGroup.push_back(sorted[i].triangle);
@@ -91,7 +98,7 @@ TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
     ++lists.start[out.cubeOfTriangle[f] + 1];
   }
   for (std::size_t c = 0; c < groups; ++c) lists.start[c + 1] += lists.start[c];
-  lists.items.resize(n);
+  resizeHugePages(lists.items, n);
   std::vector<std::uint32_t> fill(lists.start.begin(), lists.start.end() - 1);
   for (std::size_t f = 0; f < n; ++f) lists.items[fill[out.cubeOfTriangle[f]]++] = std::uint32_t(f);
   return out;
