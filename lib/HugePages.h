@@ -47,4 +47,12 @@ void resizeHugePages(std::vector<T>& v, std::size_t n) {
   v.resize(n);
 }
 
+/// A vector of n value-initialised elements on huge-page-advised memory.
+template <class T>
+std::vector<T> hugePageVector(std::size_t n) {
+  std::vector<T> v;
+  resizeHugePages(v, n);
+  return v;
+}
+
 }  // namespace surftrack

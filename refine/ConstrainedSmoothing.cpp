@@ -107,14 +107,10 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     const Point3& a = axisOf[surfel[v].n];
     return Point3{b[0] + tv * a[0], b[1] + tv * a[1], b[2] + tv * a[2]};
   };
-  std::vector<Direction> direction;
-  resizeHugePages(direction, nv);
-  std::vector<double> t;
-  resizeHugePages(t, nv);
-  std::vector<Point3> x;
-  resizeHugePages(x, nv);
-  std::vector<char> offSegment;
-  resizeHugePages(offSegment, nv);
+  std::vector<Direction> direction = hugePageVector<Direction>(nv);
+  std::vector<double> t = hugePageVector<double>(nv);
+  std::vector<Point3> x = hugePageVector<Point3>(nv);
+  std::vector<char> offSegment = hugePageVector<char>(nv);
   arena.execute([&] {
     forBlocks(nv, parallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
@@ -144,12 +140,9 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
 
   // Triangles by digital 3-cube (section 8: each has one), with the cube edges of their
   // vertices. The cubes are numbered in the order of their first triangles.
-  std::vector<Voxel> cubeOf;
-  resizeHugePages(cubeOf, nf);
-  std::vector<CubeEdges> edgesOfFace;
-  resizeHugePages(edgesOfFace, nf);
-  std::vector<char> inNoCube;
-  resizeHugePages(inNoCube, nf);
+  std::vector<Voxel> cubeOf = hugePageVector<Voxel>(nf);
+  std::vector<CubeEdges> edgesOfFace = hugePageVector<CubeEdges>(nf);
+  std::vector<char> inNoCube = hugePageVector<char>(nf);
   arena.execute([&] {
     forBlocks(nf, parallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t f = begin; f < end; ++f) {
@@ -250,19 +243,16 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   // the directed edge v -> c, (v, c, d). The ring gives both the uniform Laplacian and the
   // area-weighted normal, with one read of each neighbour. Each ring starts at the next vertex
   // of v's first triangle.
-  std::vector<std::uint32_t> ringStart;
-  resizeHugePages(ringStart, nv + 1);
+  std::vector<std::uint32_t> ringStart = hugePageVector<std::uint32_t>(nv + 1);
   for (const auto& tr : triangle)
     for (std::uint32_t v : tr) ++ringStart[v + 1];
   for (std::size_t v = 0; v < nv; ++v) ringStart[v + 1] += ringStart[v];
   // Each ring is stored closed, r_0 .. r_{k-1} r_0, at ringStart[v] + v, so that the walk over
   // its triangles has no wrap-around test.
-  std::vector<std::uint32_t> ring;
-  resizeHugePages(ring, 3 * nf + nv);
+  std::vector<std::uint32_t> ring = hugePageVector<std::uint32_t>(3 * nf + nv);
   {
     // First each corner's (next, previous) pair, in triangle order, then the chains.
-    std::vector<std::array<std::uint32_t, 2>> corner;
-    resizeHugePages(corner, 3 * nf);
+    auto corner = hugePageVector<std::array<std::uint32_t, 2>>(3 * nf);
     std::vector<std::uint32_t> next(ringStart.begin(), ringStart.end() - 1);
     for (const auto& tr : triangle)
       for (int j = 0; j < 3; ++j) corner[next[tr[j]]++] = {tr[(j + 1) % 3], tr[(j + 2) % 3]};
@@ -291,12 +281,9 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   // the vertices or on the thread count. A vertex moves along its axis by the change of its t;
   // the final points are computed from t. The fold check keeps the t of the pass's start of the
   // vertices it may put back (`previous`, of the checked cubes' vertices alone).
-  std::vector<double> previous;
-  resizeHugePages(previous, nv);
-  std::vector<Point3> xNext;
-  resizeHugePages(xNext, nv);
-  std::vector<int> halved;
-  resizeHugePages(halved, nv);
+  std::vector<double> previous = hugePageVector<double>(nv);
+  std::vector<Point3> xNext = hugePageVector<Point3>(nv);
+  std::vector<int> halved = hugePageVector<int>(nv);
   std::vector<char> queued(checked.size(), 0);
   std::vector<std::uint32_t> queue;
   // Each vertex's step per unit of Laplacian, t += factor (L . w): w = n / (a . n) to move to
@@ -306,8 +293,7 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   // segment, would push the vertex off the surface. The normals are those of the iteration's
   // start, shared by its two passes (section 8). stepOf holds w / degree, to apply to the sum of
   // the neighbours' offsets.
-  std::vector<Point3> stepOf;
-  resizeHugePages(stepOf, nv);
+  std::vector<Point3> stepOf = hugePageVector<Point3>(nv);
   const bool prefetch = nv > kPrefetchPoints;
   auto move = [&](double factor, bool newNormals, std::size_t begin, std::size_t end) {
     const Point3* const xs = x.data();

@@ -22,8 +22,7 @@ struct Record {
 std::vector<Record> sortByKey(std::vector<Record> in, int bits) {
   constexpr int kDigit = 11;
   constexpr std::size_t kBuckets = std::size_t(1) << kDigit;
-  std::vector<Record> out;
-  resizeHugePages(out, in.size());
+  std::vector<Record> out = hugePageVector<Record>(in.size());
   std::array<std::uint32_t, kBuckets> count;
   for (int shift = 0; shift < bits; shift += kDigit) {
     count.fill(0);
@@ -56,8 +55,7 @@ TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
     }
   std::array<int, 3> width{};
   for (int k = 0; k < 3; ++k) width[k] = int(std::bit_width(std::uint64_t(std::int64_t(hi[k]) - lo[k])));
-  std::vector<Record> records;
-  resizeHugePages(records, n);
+  std::vector<Record> records = hugePageVector<Record>(n);
   std::vector<Record> sorted;
   if (width[0] + width[1] + width[2] <= 64) {
     for (std::size_t f = 0; f < n; ++f) {
@@ -79,8 +77,7 @@ TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
   }
 
   // Groups in key order, then renumbered by their first (least) triangle.
-  std::vector<std::uint32_t> groupOf, firstOfGroup;
-  resizeHugePages(groupOf, n);
+  std::vector<std::uint32_t> groupOf = hugePageVector<std::uint32_t>(n), firstOfGroup;
   for (std::size_t i = 0; i < n; ++i) {
     if (i == 0 || sorted[i].key != sorted[i - 1].key)
       firstOfGroup.push_back(sorted[i].triangle);
