@@ -1,8 +1,8 @@
 // What decimate() costs against what OpenMesh's Decimater costs without its guards (docs/
 // performance.md, "Smoothing and decimation"): the same closed mesh (a PLY file, e.g. the
 // smoothed sphere bench_refine writes) reduced to the same triangle count by
-//  - "openmesh": OpenMesh's DecimaterT with the quadric module alone (no link condition, no
-//    embedding or distance guard): the floor of any decimation built on OpenMesh's collapses;
+//  - "openmesh": OpenMesh's DecimaterT with the quadric module alone (OpenMesh's own collapse
+//    legality, is_collapse_ok, and no guard of this project's);
 //  - "link": this project's CheckedDecimaterT (refine/CheckedDecimater.h) with the quadric, the
 //    normal-flip module and the link condition (refine/TopologyGuard.h), no embedding guard and
 //    no distance bound: what keeping the topology alone costs;
@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -35,8 +36,9 @@ const char* kUsage =
     "usage: bench_decimation_floor --input MESH.ply [--reduce F] [--max-error E] [--reps N]\n"
     "                              [--only openmesh|link|safe]\n"
     "  Decimates the closed mesh MESH to (1 - F) of its triangles (default F 0.9) three ways:\n"
-    "  OpenMesh's DecimaterT with the quadric alone, the checked decimater with the link\n"
-    "  condition alone, and decimateSafely within E (default 0.5, the mesh's units); median CPU\n"
+    "  OpenMesh's DecimaterT with the quadric module alone, the checked decimater with the\n"
+    "  quadric, normal-flip and link-condition modules, and decimateSafely within E (default\n"
+    "  0.5, the mesh's units), which adds the embedding and distance guards; median CPU\n"
     "  seconds of N runs (default 3) each, as one JSON object; --only runs one of them (profiling).\n";
 
 void prepare(SurfaceMesh& m) {
@@ -70,7 +72,7 @@ std::size_t linkOnly(SurfaceMesh& m, std::size_t target) {
   d.add(flipping);
   d.add(guard);
   d.module(quadric).unset_max_err();
-  d.module(flipping).set_max_normal_deviation(60);
+  d.module(flipping).set_max_normal_deviation(refine::DecimationParameters{}.maxNormalDeviation);
   d.initialize();
   auto& q = d.module(quadric);
   d.decimateToFaces(target, [&](const auto& ci) { return q.collapse_priority(ci); });

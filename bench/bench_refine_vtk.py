@@ -10,9 +10,10 @@ reduction. Reports for each result the RMS of |x - c| - R over the vertices (the
 the enclosed volume against the extracted mesh's, the times, and, from surftrack_mesh_check
 (CGAL, tests/mesh_check.cpp; --skip-checks leaves it out), closedness, genus and
 self-intersecting triangle pairs. With --floor it also runs bench_decimation_floor on the mesh
-both tools decimate: OpenMesh's Decimater with the quadric alone, then with the link condition
-alone, then decimateSafely, each to the same triangle count (what the guards cost, against VTK's
-figure of the same run). Times are wall and CPU seconds of the calls alone (the
+both tools decimate: OpenMesh's DecimaterT with the quadric module alone, the checked decimater
+with the quadric, normal-flip and link-condition modules, then decimateSafely (which adds the
+embedding and distance guards), each to the same triangle count (what the guards cost, against
+VTK's figure of the same run). Times are wall and CPU seconds of the calls alone (the
 process's CPU time, all threads, for surftrack's smoothing and for VTK; the thread's for
 surftrack's decimation, which runs on one). Both smoothings get the same thread count (--threads,
 default 2: surftrack's SmoothOptions::threads, VTK's vtkSMPTools, whose backend is TBB in

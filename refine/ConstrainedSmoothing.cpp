@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include "BoundaryMapping.h"
+#include "CompressedLists.h"
 #include "CubeFoldCheck.h"
 #include "DigitalCube.h"
 #include "FoldCertificate.h"
@@ -53,21 +54,7 @@ void forBlocks(std::size_t n, bool parallel, Body&& body) {
                       [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
 }
 
-Lists invert(const std::vector<std::uint32_t>& owner, std::size_t count) {
-  Lists out;
-  out.start.assign(count + 1, 0);
-  for (std::uint32_t o : owner) ++out.start[o + 1];
-  for (std::size_t i = 0; i < count; ++i) out.start[i + 1] += out.start[i];
-  out.items.resize(owner.size());
-  std::vector<std::uint32_t> next(out.start.begin(), out.start.end() - 1);
-  for (std::size_t k = 0; k < owner.size(); ++k) out.items[next[owner[k]]++] = std::uint32_t(k);
-  return out;
-}
-
 }  // namespace
-
-// The arrays below are written once, front to back, and are as large as the mesh: they are
-// backed by huge pages (lib/HugePages.h), whose first writes cost a fifth of 4 KiB pages'.
 
 SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfel,
                                  const std::vector<std::array<std::uint32_t, 3>>& triangle,
@@ -94,17 +81,20 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   // is affine): a is the image of the surfel's direction d - c, one of the six unit vectors,
   // so a vertex's segment is its surfel's 1-voxel and direction, and the passes read one byte
   // for its axis. The fold check works in index space, on c + t (d - c). x holds the points.
-  std::array<Point3, 6> axisOf;
+  // The arrays as large as the mesh are first written front to back: they are backed by huge
+  // pages, whose first writes cost a fifth of 4 KiB pages' (lib/HugePages.h;
+  // docs/performance.md, "Fresh memory on this machine").
+  std::array<Point3, 6> physicalAxis;  // by Direction (lib/Voxel.h)
   std::array<double, 6> inverseLength2Of;
   for (Direction n = 0; n < 6; ++n) {
     const Voxel u = unitVector(n);
-    axisOf[n] = geometry.toPhysicalOffset({double(u.x), double(u.y), double(u.z)});
-    inverseLength2Of[n] = 1.0 / dot(axisOf[n], axisOf[n]);
+    physicalAxis[n] = geometry.toPhysicalOffset({double(u.x), double(u.y), double(u.z)});
+    inverseLength2Of[n] = 1.0 / dot(physicalAxis[n], physicalAxis[n]);
   }
   auto physicalPoint = [&](std::size_t v, double tv) {
     const Voxel c = surfel[v].inside();
     const Point3 b = geometry.toPhysical({double(c.x), double(c.y), double(c.z)});
-    const Point3& a = axisOf[surfel[v].n];
+    const Point3& a = physicalAxis[surfel[v].n];
     return Point3{b[0] + tv * a[0], b[1] + tv * a[1], b[2] + tv * a[2]};
   };
   std::vector<Direction> direction = hugePageVector<Direction>(nv);
@@ -114,9 +104,13 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   arena.execute([&] {
     forBlocks(nv, parallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
+        if (surfel[v].n >= 6) {  // no direction of Z^3 (a surfel decoded from a bad key)
+          offSegment[v] = 2;
+          continue;
+        }
         direction[v] = surfel[v].n;
         const Point3 base = physicalPoint(v, 0);
-        const Point3& a = axisOf[direction[v]];
+        const Point3& a = physicalAxis[direction[v]];
         const Point3 r = sub(points[v], base);
         const double tv = dot(r, a) * inverseLength2Of[direction[v]];
         double off = 0;
@@ -127,10 +121,14 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
       }
     });
   });
-  if (const auto bad = std::find(offSegment.begin(), offSegment.end(), 1); bad != offSegment.end()) {
+  if (const auto bad = std::find_if(offSegment.begin(), offSegment.end(), [](char c) { return c != 0; });
+      bad != offSegment.end()) {
     const std::size_t v = std::size_t(bad - offSegment.begin());
     std::ostringstream msg;
-    msg << "vertex " << v << " is not inside the segment of its " << surfel[v];
+    if (offSegment[v] == 2)
+      msg << "vertex " << v << " has a surfel of direction " << int(surfel[v].n) << ", not one of 0 to 5";
+    else
+      msg << "vertex " << v << " is not inside the segment of its " << surfel[v];
     throw std::invalid_argument(msg.str());
   }
   auto indexPoint = [&](std::uint32_t v) {
@@ -163,8 +161,7 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
         << "smoothing needs the continuous analog itself (smooth before decimating)";
     throw std::invalid_argument(msg.str());
   }
-  const TrianglesByCube byCube = groupTrianglesByCube(cubeOf);
-  const Lists& facesOfCube = byCube.trianglesOfCube;
+  const Lists facesOfCube = groupTrianglesByCube(cubeOf);
   const std::size_t nc = facesOfCube.size();
   report.cubes = nc;
   // What the fold check of each cube must test in a pass: its triangles and pairs of triangles
@@ -277,8 +274,8 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   }
 
   // The passes are Jacobi updates: every vertex reads the points x of the pass's start and
-  // writes its own t and next point alone, so a pass's result does not depend on the order of
-  // the vertices or on the thread count. A vertex moves along its axis by the change of its t;
+  // writes its own t, next point and (in a λ pass) step alone, so a pass's result does not
+  // depend on the order of the vertices or on the thread count. A vertex moves along its axis by the change of its t;
   // the final points are computed from t. The fold check keeps the t of the pass's start of the
   // vertices it may put back (`previous`, of the checked cubes' vertices alone).
   std::vector<double> previous = hugePageVector<double>(nv);
@@ -301,12 +298,13 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     for (std::size_t v = begin; v < end; ++v) {
       // The neighbours' points are the only reads out of order: on a mesh whose points do not
       // fit the cache, those of the vertex kPrefetchDistance ahead are requested now, so that
-      // the pass waits for memory less (docs/performance.md: 16 % of the smoothing's time on
-      // the MRI cortex; on a mesh that fits, the extra walk costs more than it saves).
+      // the pass waits for memory less (docs/performance.md, "Current figures": the MRI
+      // cortex's smoothing 2.05 -> 1.72 s; on a mesh that fits, the extra walk cost more than
+      // it saved).
       if (const std::size_t w = v + kPrefetchDistance; prefetch && w < end)
         for (std::size_t k = ringStart[w] + w, e = ringStart[w + 1] + w; k < e; ++k) __builtin_prefetch(&xs[rs[k]]);
       const Point3 xv = xs[v];
-      const Point3& axis = axisOf[direction[v]];
+      const Point3& axis = physicalAxis[direction[v]];
       const std::size_t first = ringStart[v] + v, last = ringStart[v + 1] + v;
       // The umbrella Laplacian, the mean of the neighbours minus x (summed as offsets from x),
       // and with new normals the area-weighted normal, the sum over the triangles
@@ -372,7 +370,7 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
         ++report.stepsBack;
         t[v] = ++halved[v] > p.halvings ? previous[v] : previous[v] + (t[v] - previous[v]) / 2;
         const double dt = t[v] - previous[v];
-        const Point3& axis = axisOf[direction[v]];
+        const Point3& axis = physicalAxis[direction[v]];
         xNext[v] = {x[v][0] + dt * axis[0], x[v][1] + dt * axis[1], x[v][2] + dt * axis[2]};
         for (std::uint32_t j : checkedOfVertex[v])
           if (!queued[j]) {

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <tuple>
 #include <utility>
 
 #include "HugePages.h"
-#include <tuple>
 
 namespace surftrack::refine {
 
@@ -37,14 +37,9 @@ std::vector<Record> sortByKey(std::vector<Record> in, int bits) {
 
 }  // namespace
 
-TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
+Lists groupTrianglesByCube(std::span<const Voxel> cube) {
   const std::size_t n = cube.size();
-  TrianglesByCube out;
-  // The arrays as large as the input are written once, front to back: huge pages
-  // (lib/HugePages.h).
-  resizeHugePages(out.cubeOfTriangle, n);
-  out.trianglesOfCube.start.assign(1, 0);
-  if (n == 0) return out;
+  if (n == 0) return invert({}, 0);
 
   // Keys: the corner's offsets from the least corner, packed in as few bits as they need.
   Voxel lo = cube[0], hi = cube[0];
@@ -57,7 +52,8 @@ TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
   for (int k = 0; k < 3; ++k) width[k] = int(std::bit_width(std::uint64_t(std::int64_t(hi[k]) - lo[k])));
   std::vector<Record> records = hugePageVector<Record>(n);
   std::vector<Record> sorted;
-  if (width[0] + width[1] + width[2] <= 64) {
+  // (A shift by 64 would be undefined: the keys take 63 bits at most.)
+  if (width[0] + width[1] + width[2] < 64) {
     for (std::size_t f = 0; f < n; ++f) {
       const Voxel& c = cube[f];
       records[f] = {std::uint64_t(std::int64_t(c.x) - lo.x) | (std::uint64_t(std::int64_t(c.y) - lo.y) << width[0]) |
@@ -88,17 +84,8 @@ TrianglesByCube groupTrianglesByCube(std::span<const Voxel> cube) {
   std::uint32_t next = 0;
   for (std::size_t f = 0; f < n; ++f)
     if (firstOfGroup[groupOf[f]] == f) number[groupOf[f]] = next++;
-  Lists& lists = out.trianglesOfCube;
-  lists.start.assign(groups + 1, 0);
-  for (std::size_t f = 0; f < n; ++f) {
-    out.cubeOfTriangle[f] = number[groupOf[f]];
-    ++lists.start[out.cubeOfTriangle[f] + 1];
-  }
-  for (std::size_t c = 0; c < groups; ++c) lists.start[c + 1] += lists.start[c];
-  resizeHugePages(lists.items, n);
-  std::vector<std::uint32_t> fill(lists.start.begin(), lists.start.end() - 1);
-  for (std::size_t f = 0; f < n; ++f) lists.items[fill[out.cubeOfTriangle[f]]++] = std::uint32_t(f);
-  return out;
+  for (std::uint32_t& g : groupOf) g = number[g];  // each triangle's cube
+  return invert(groupOf, groups);
 }
 
 }  // namespace surftrack::refine

@@ -1,5 +1,6 @@
-// Area-weighted vertex normals of a triangle mesh: the one place they are summed, for the
-// smoothing's step (docs/theory.md, section 8) and the front door's vertexNormals (docs/api.md).
+// Area-weighted vertex normals of a triangle mesh, for the front door's vertexNormals
+// (docs/api.md). The smoothing's step sums them around each vertex's ring as it walks it
+// (docs/theory.md, section 8), with the Laplacian in the same walk.
 #pragma once
 
 #include <algorithm>

@@ -10,11 +10,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <optional>
 #include <random>
-#include <map>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "CaseSubset.h"
@@ -323,6 +325,10 @@ TEST(RefineErrors, BadOptionsAndInputsThrowInvalidInput) {
   t.vertices[0][1] += 0.25;
   t.vertices[0][2] += 0.25;
   EXPECT_THROW(smooth(t, {}), InvalidInput);
+  // A surfel with no direction of Z^3 (Surfel::fromKey decodes 6 and 7 from a bad key).
+  Surface u = extractFrom(p.image, Selection::threshold(p.iso), SeedRule::largest(), Mapping::Midpoint);
+  u.surfels[3].n = 6;
+  EXPECT_THROW(smooth(u, {}), InvalidInput);
 }
 
 #ifdef SURFTRACK_TEST_MRICRON
@@ -482,36 +488,37 @@ TEST(RefineSurface, SmoothsThenDecimatesAsTheTwoCalls) {
 
 // groupTrianglesByCube (the fold check's grouping, refine/TrianglesByCube.h) against a std::map
 // of the corners: the same groups, numbered in the order of their first triangles, each listing
-// its triangles in increasing order; corners near together (one packed key, the radix sort),
-// negative ones, and ones too far apart for a 64-bit key (the comparison sort).
+// its triangles in increasing order; corners near together (one packed key and one or two radix
+// passes, or three), negative ones, and ones too far apart for a 64-bit key (the comparison
+// sort), among them x and y over all of int with z constant (widths 32, 32, 0).
 TEST(TrianglesByCube, GroupsAsAMapOfTheCornersDoes) {
   std::mt19937 rng(20261202);
-  for (int trial = 0; trial < 300; ++trial) {
-    const int spread = trial % 3 == 0 ? 3 : trial % 3 == 1 ? 1000 : (1 << 30);
-    std::uniform_int_distribution<int> coordinate(-spread, spread);
+  constexpr int kSpread[] = {3, 100, 1000, 1 << 30};
+  for (int trial = 0; trial < 400; ++trial) {
+    const int spread = kSpread[trial % 5 == 4 ? 3 : trial % 4];
+    const bool flatZ = trial % 5 == 4;  // x, y over all of int, z constant
+    std::uniform_int_distribution<int> coordinate(flatZ ? std::numeric_limits<int>::min() : -spread,
+                                                  flatZ ? std::numeric_limits<int>::max() : spread);
     const std::size_t n = std::size_t(rng() % 2000);
     std::vector<Voxel> corner(n);
-    for (auto& c : corner) {
+    for (std::size_t f = 0; f < n; ++f) {
       // Repeat earlier corners often, so that groups have several triangles.
-      if (!corner.empty() && &c != corner.data() && rng() % 2)
-        c = corner[rng() % std::size_t(&c - corner.data())];
+      if (f > 0 && rng() % 2)
+        corner[f] = corner[rng() % f];
       else
-        c = {coordinate(rng), coordinate(rng), coordinate(rng)};
+        corner[f] = {coordinate(rng), coordinate(rng), flatZ ? 7 : coordinate(rng)};
     }
     std::map<std::tuple<int, int, int>, std::uint32_t> number;
     std::vector<std::vector<std::uint32_t>> members;
-    std::vector<std::uint32_t> expected(n);
     for (std::size_t f = 0; f < n; ++f) {
       const auto [it, added] = number.try_emplace({corner[f].x, corner[f].y, corner[f].z}, std::uint32_t(members.size()));
       if (added) members.emplace_back();
-      expected[f] = it->second;
       members[it->second].push_back(std::uint32_t(f));
     }
-    const refine::TrianglesByCube got = refine::groupTrianglesByCube(corner);
-    ASSERT_EQ(got.cubeOfTriangle, expected) << "trial " << trial;
-    ASSERT_EQ(got.trianglesOfCube.size(), members.size()) << "trial " << trial;
+    const refine::Lists got = refine::groupTrianglesByCube(corner);
+    ASSERT_EQ(got.size(), members.size()) << "trial " << trial;
     for (std::size_t c = 0; c < members.size(); ++c) {
-      const auto list = got.trianglesOfCube[c];
+      const auto list = got[c];
       ASSERT_EQ(std::vector<std::uint32_t>(list.begin(), list.end()), members[c]) << "trial " << trial << " cube " << c;
     }
   }
