@@ -97,6 +97,11 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     const Point3& a = physicalAxis[surfel[v].n];
     return Point3{b[0] + tv * a[0], b[1] + tv * a[1], b[2] + tv * a[2]};
   };
+  // The table has the six directions of Z^3 only (Surfel::fromKey decodes 6 and 7 too).
+  if (const auto bad = std::find_if(surfel.begin(), surfel.end(), [](const Surfel& s) { return s.n >= 6; });
+      bad != surfel.end())
+    throw std::invalid_argument("smoothing: vertex " + std::to_string(bad - surfel.begin()) +
+                                " has a surfel of direction " + std::to_string(int(bad->n)) + ", not one of 0 to 5");
   std::vector<Direction> direction = hugePageVector<Direction>(nv);
   std::vector<double> t = hugePageVector<double>(nv);
   std::vector<Point3> x = hugePageVector<Point3>(nv);
@@ -104,10 +109,6 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   arena.execute([&] {
     forBlocks(nv, parallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
-        if (surfel[v].n >= 6) {  // no direction of Z^3 (a surfel decoded from a bad key)
-          offSegment[v] = 2;
-          continue;
-        }
         direction[v] = surfel[v].n;
         const Point3 base = physicalPoint(v, 0);
         const Point3& a = physicalAxis[direction[v]];
@@ -117,18 +118,14 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
         for (int k = 0; k < 3; ++k) off = std::max(off, std::abs(r[k] - tv * a[k]));
         offSegment[v] = !(tv > 0 && tv < 1) || off > 1e-6 * norm(a);
         t[v] = std::clamp(tv, p.epsilon, 1 - p.epsilon);
-        x[v] = physicalPoint(v, t[v]);
+        x[v] = {base[0] + t[v] * a[0], base[1] + t[v] * a[1], base[2] + t[v] * a[2]};
       }
     });
   });
-  if (const auto bad = std::find_if(offSegment.begin(), offSegment.end(), [](char c) { return c != 0; });
-      bad != offSegment.end()) {
+  if (const auto bad = std::find(offSegment.begin(), offSegment.end(), 1); bad != offSegment.end()) {
     const std::size_t v = std::size_t(bad - offSegment.begin());
     std::ostringstream msg;
-    if (offSegment[v] == 2)
-      msg << "vertex " << v << " has a surfel of direction " << int(surfel[v].n) << ", not one of 0 to 5";
-    else
-      msg << "vertex " << v << " is not inside the segment of its " << surfel[v];
+    msg << "vertex " << v << " is not inside the segment of its " << surfel[v];
     throw std::invalid_argument(msg.str());
   }
   auto indexPoint = [&](std::uint32_t v) {
@@ -275,9 +272,10 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
 
   // The passes are Jacobi updates: every vertex reads the points x of the pass's start and
   // writes its own t, next point and (in a λ pass) step alone, so a pass's result does not
-  // depend on the order of the vertices or on the thread count. A vertex moves along its axis by the change of its t;
-  // the final points are computed from t. The fold check keeps the t of the pass's start of the
-  // vertices it may put back (`previous`, of the checked cubes' vertices alone).
+  // depend on the order of the vertices or on the thread count. A vertex moves along its axis
+  // by the change of its t; the final points are computed from t. The fold check keeps the t of
+  // the pass's start of the vertices it may put back (`previous`, of the checked cubes'
+  // vertices alone).
   std::vector<double> previous = hugePageVector<double>(nv);
   std::vector<Point3> xNext = hugePageVector<Point3>(nv);
   std::vector<int> halved = hugePageVector<int>(nv);

@@ -41,7 +41,7 @@ struct SmoothingReport {
 /// \pre the mesh is a continuous analog as the converter builds it: a closed, oriented
 ///      2-manifold every triangle of which has its vertices on edges of one digital 3-cube.
 /// \throw std::invalid_argument for parameters out of range, sizes that differ, a vertex index
-///        out of range, a vertex off its segment, or a triangle whose vertices lie in no single
+///        out of range, a surfel direction outside 0-5, a vertex off its segment, or a triangle whose vertices lie in no single
 ///        cube (e.g. a decimated mesh); std::logic_error (requireClosedOrientedManifold,
 ///        converter/SurfaceMesh.h) for triangles that are no closed, oriented 2-manifold.
 SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfels,
