@@ -93,9 +93,9 @@ VolumeStats valueStats(const VolumeView& volume, const Extraction& x) {
   const VolumeStats stats = valueStats(volume, x);
   const std::string range = "[" + formatNumber(stats.min) + ", " + formatNumber(stats.max) + "]";
   if (x.byLabel) {
-    if (countEqual(volume, x.value) == 0) {
+    if (countEqual(volume, x.label) == 0) {
       std::ostringstream msg;
-      msg << "empty selection: label " << formatNumber(x.value) << " does not occur in '" << x.input << "'";
+      msg << "empty selection: label " << x.label.text() << " does not occur in '" << x.input << "'";
       if (!stats.labels.empty()) {
         msg << " (labels present: ";
         std::size_t shown = 0;
@@ -104,7 +104,7 @@ VolumeStats valueStats(const VolumeView& volume, const Extraction& x) {
             msg << ", ...";
             break;
           }
-          msg << (shown++ ? ", " : "") << value;
+          msg << (shown++ ? ", " : "") << value.text();
         }
         msg << ")";
       } else {
@@ -135,7 +135,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   x.seedMode = o.seedMode;
   x.byLabel = o.label.has_value();
   if (o.label) {
-    x.value = *o.label;
+    x.label = *o.label;
   } else if (o.iso) {
     x.value = *o.iso;
     // The scanning rules read every voxel anyway: one more pass checks the iso-value against
@@ -165,7 +165,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   clock.lap(x.timings, "values");
 
   ExtractOptions eo;
-  eo.selection = x.byLabel ? Selection::label(x.value) : Selection::threshold(x.value);
+  eo.selection = x.byLabel ? Selection::label(x.label) : Selection::threshold(x.value);
   eo.seed = seedRuleOf(o);
   eo.pair = o.pair;
   eo.threads = o.threads;

@@ -71,7 +71,8 @@ struct Extraction {
 
   // The binary image and the surface options.
   bool byLabel = false;
-  double value = 0;               ///< the iso-value or the label
+  double value = 0;               ///< the iso-value
+  LabelValue label;               ///< the label (byLabel)
   bool valueFromOtsu = false;     ///< no --iso / --label: Otsu's threshold was used
   AdjacencyPair pair = AdjacencyPair::k26_6;
   std::string mapping;            ///< "linear" or "midpoint"

@@ -21,18 +21,12 @@ LabelNames readLabelNames(const std::string& path) {
     std::istringstream fields(line);
     std::string first;
     if (!(fields >> first) || first[0] == '#') continue;
-    long long value = 0;
+    const std::optional<LabelValue> value = LabelValue::parse(first);  // exact: 64-bit ids too
     std::string name;
-    std::size_t used = 0;
-    try {
-      value = std::stoll(first, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != first.size() || !(fields >> name))
+    if (!value || !(fields >> name))
       throw std::runtime_error("cannot read label names '" + path + "': line " + std::to_string(number) +
                                " is not 'value name'");
-    names[value] = name;
+    names[*value] = name;
   }
   if (in.bad()) throw std::runtime_error("cannot read label names '" + path + "': read error");
   return names;
@@ -52,9 +46,9 @@ std::optional<std::string> labelNamesSidecar(const std::string& volumePath) {
   return std::nullopt;
 }
 
-std::string labelName(const LabelNames& names, long long label) {
+std::string labelName(const LabelNames& names, const LabelValue& label) {
   const auto it = names.find(label);
-  return it != names.end() ? it->second : "label" + std::to_string(label);
+  return it != names.end() ? it->second : "label" + label.text();
 }
 
 }  // namespace surftrack::cli

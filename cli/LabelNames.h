@@ -7,9 +7,11 @@
 #include <optional>
 #include <string>
 
+#include "LabelValue.h"
+
 namespace surftrack::cli {
 
-using LabelNames = std::map<long long, std::string>;
+using LabelNames = std::map<LabelValue, std::string>;
 
 /// The table in `path`. Blank lines and lines starting with '#' are skipped.
 /// \throw std::runtime_error (one line, naming the file and the line) when the file cannot be
@@ -21,6 +23,6 @@ LabelNames readLabelNames(const std::string& path);
 std::optional<std::string> labelNamesSidecar(const std::string& volumePath);
 
 /// The name of `label` in `names`, or "label<N>".
-std::string labelName(const LabelNames& names, long long label);
+std::string labelName(const LabelNames& names, const LabelValue& label);
 
 }  // namespace surftrack::cli

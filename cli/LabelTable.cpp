@@ -32,7 +32,7 @@ std::string labelTableCsv(const std::vector<LabelRow>& rows) {
 nlohmann::ordered_json labelTableJson(const std::vector<LabelRow>& rows) {
   nlohmann::ordered_json table = nlohmann::ordered_json::array();
   for (const LabelRow& r : rows)
-    table.push_back({{"label", r.label},
+    table.push_back({{"label", labelJson(r.label)},
                      {"name", r.name},
                      {"voxels", r.voxels},
                      {"voxel_volume", number(r.voxelVolume)},

@@ -5,12 +5,14 @@
 #include <string>
 #include <vector>
 
+#include "LabelValue.h"
+
 #include <nlohmann/json_fwd.hpp>
 
 namespace surftrack::cli {
 
 struct LabelRow {
-  long long label = 0;
+  LabelValue label;  ///< exact (64-bit ids)
   std::string name;
   std::uint64_t voxels = 0;
   double voxelVolume = 0;  ///< voxels times the physical volume of one voxel

@@ -103,10 +103,9 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   const VolumeView& view = volume.view;
 
   LabelOptions options;
-  if (o.range) options.labels = LabelSelection::range(double((*o.range)[0]), double((*o.range)[1]));
-  else if (!o.labels.empty())
-    options.labels = LabelSelection::list(std::vector<double>(o.labels.begin(), o.labels.end()));
-  options.background = double(o.background);
+  if (o.range) options.labels = LabelSelection::range((*o.range)[0], (*o.range)[1]);
+  else if (!o.labels.empty()) options.labels = LabelSelection::list(o.labels);
+  options.background = o.background;
   options.boundaries = o.largest ? LabelBoundaries::Largest : LabelBoundaries::All;
   options.seeds = o.seeds;
   options.pair = o.pair;
@@ -120,7 +119,7 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   std::set<std::string> files;
   for (const LabelSurface& ls : surfaces) {
     LabelRow r;
-    r.label = (long long)ls.label;
+    r.label = ls.label;
     r.name = labelName(names, r.label);
     r.voxels = ls.voxels;
     r.voxelVolume = double(ls.voxels) * voxelVolume;
@@ -138,7 +137,7 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
       std::string file = kind == OutputKind::Pattern ? o.output
                          : names.empty()             ? (fs::path(o.output) / "label_{label}.ply").string()
                                                      : (fs::path(o.output) / "{label}_{name}.ply").string();
-      replaceAll(file, "{label}", std::to_string(r.label));
+      replaceAll(file, "{label}", r.label.text());
       replaceAll(file, "{name}", fileSafe(r.name));
       if (!files.insert(file).second)
         throw UsageError("two labels give the file name '" + file + "': put {label} in the pattern");

@@ -42,6 +42,16 @@ std::optional<long long> toInteger(const std::string& text) {
   return value;
 }
 
+/// A label, exactly: decimal digits with an optional sign up to 64 bits (segment ids above
+/// 2^53 included), or a number that is an integer of at most 2^53 ("1e3", "5.0"), where doubles
+/// are still exact.
+std::optional<LabelValue> toLabel(const std::string& text) {
+  if (auto L = LabelValue::parse(text)) return L;
+  const auto v = toNumber(text);
+  if (!v || !(std::fabs(*v) <= 0x1p53)) return std::nullopt;
+  return LabelValue::fromDouble(*v);
+}
+
 /// The comma-separated parts of `text`, spaces dropped: "1, 2,3" -> {"1", "2", "3"}.
 std::vector<std::string> splitCommas(const std::string& text) {
   std::vector<std::string> parts;
@@ -87,6 +97,12 @@ const CLI::Validator kInteger(
       return std::string();
     },
     "INTEGER");
+
+const CLI::Validator kLabel(
+    [](std::string& s) {
+      return toLabel(s) ? std::string() : "'" + s + "' is not an integer label (decimal, up to 64 bits)";
+    },
+    "LABEL");
 
 /// `check`, a CLI11 validator, with the tool's own message when it fails.
 CLI::Validator explained(const CLI::Validator& check,
@@ -403,9 +419,9 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
       ->check(kNumber)
       ->group("what is inside (1-voxels)");
   addValue(
-      app, "--label", "L", [&o](const std::string& s) { o.surface.label = toNumber(s); },
-      "voxels with value = L")
-      ->check(kNumber)
+      app, "--label", "L", [&o](const std::string& s) { o.surface.label = toLabel(s); },
+      "voxels with value = L (an integer, exact up to 64 bits)")
+      ->check(kLabel)
       ->group("what is inside (1-voxels)");
 
   const std::string which = "which surface (one of)";
@@ -557,13 +573,13 @@ void parseLabelList(const std::string& text, LabelsOptions& o) {
       skip = 1;
     }
     if (dash != std::string::npos) {
-      const auto a = toInteger(part.substr(0, dash)), b = toInteger(part.substr(dash + skip));
+      const auto a = toLabel(part.substr(0, dash)), b = toLabel(part.substr(dash + skip));
       if (!a || !b) throw UsageError("--labels: '" + part + "' is not a range A-B of integers");
       if (*a > *b) throw UsageError("--labels: the range '" + part + "' is empty");
       if (parts.size() > 1) throw UsageError("--labels: give a list of labels or one range, not both");
-      o.range = std::array<long long, 2>{*a, *b};
+      o.range = std::array<LabelValue, 2>{*a, *b};
     } else {
-      const auto v = toInteger(part);
+      const auto v = toLabel(part);
       if (!v) throw UsageError("--labels: '" + part + "' is not an integer label");
       o.labels.push_back(*v);
     }
@@ -600,9 +616,9 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
   app.add_option("--labels", args.labels, "labels 3,17,42 or a range 10-20 (default: every label)")
       ->option_text("LIST")
       ->group(which);
-  app.add_option("--background", o.background, "the label of no surface (default: 0)")
-      ->option_text("L")
-      ->transform(kInteger)
+  addValue(app, "--background", "L", [&o](const std::string& s) { o.background = *toLabel(s); },
+           "the label of no surface (default: 0)")
+      ->check(kLabel)
       ->group(which);
   app.add_flag("--largest", o.largest, "only the largest boundary of each label (default: all)")->group(which);
   app.add_option("--seed", args.seeds, "only the boundaries reached from voxel x,y,z (walking +x to its\n"

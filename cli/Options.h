@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "AdjacencyPair.h"
+#include "LabelValue.h"
 #include "ReadVolume.h"
 #include "Surfel.h"
 
@@ -49,7 +50,7 @@ struct RefineOptions {
 /// What surface to extract: a threshold or a label, a seed rule, a pair, a mapping.
 struct SurfaceOptions {
   std::optional<double> iso;     ///< --iso S: 1-voxels are f > S
-  std::optional<double> label;   ///< --label L: 1-voxels are f = L
+  std::optional<LabelValue> label;  ///< --label L: 1-voxels are f = L (exact: 64-bit ids)
   SeedMode seedMode = SeedMode::Largest;
   Voxel seedVoxel;               ///< --seed x,y,z (Voxel), --seed-ray x,y,z (Ray) or the c of --seed x,y,z,DIR
   Direction seedDirection = 0;   ///< the DIR of --seed x,y,z,DIR (SeedMode::Surfel)
@@ -92,9 +93,9 @@ struct LabelsOptions {
   InputOptions input;
   /// -o: a directory (DIR/), a name pattern with {label} and/or {name}, or one .ply file.
   std::string output;
-  std::vector<long long> labels;                   ///< --labels 3,17,42
-  std::optional<std::array<long long, 2>> range;   ///< --labels 10-20 (or 10..20)
-  long long background = 0;                        ///< --background L
+  std::vector<LabelValue> labels;                  ///< --labels 3,17,42
+  std::optional<std::array<LabelValue, 2>> range;  ///< --labels 10-20 (or 10..20)
+  LabelValue background = 0;                       ///< --background L
   std::string labelNames;                          ///< --label-names FILE
   bool noNames = false;                            ///< --no-label-names: ignore a sidecar
   bool largest = false;                            ///< --largest

@@ -19,6 +19,11 @@ std::string num(double v, int precision) {
   return s.str();
 }
 
+json labelJson(const LabelValue& label) {
+  if (label.negative()) return json(label.as<std::int64_t>());
+  return json(label.magnitude());
+}
+
 json number(double v) {
   if (!std::isfinite(v)) return nullptr;
   if (v == std::floor(v) && std::abs(v) < 1e15) return static_cast<std::int64_t>(v);
@@ -192,7 +197,7 @@ void printSummary(std::ostream& out, const Extraction& x) {
     std::ostringstream s;
     if (x.dataRange) s << "range [" << num((*x.dataRange)[0]) << ", " << num((*x.dataRange)[1]) << "]; ";
     s << "inside: f ";
-    if (x.byLabel) s << "= " << num(x.value, 10) << " (label)";
+    if (x.byLabel) s << "= " << x.label.text() << " (label)";
     else s << "> " << num(x.value, 10) << (x.valueFromOtsu ? " (Otsu's threshold; set it with --iso)" : "");
     row(out, "values", s.str());
   }
@@ -286,7 +291,7 @@ json extractionJson(const Extraction& x) {
   if (x.dataRange) j["data_range"] = {number((*x.dataRange)[0]), number((*x.dataRange)[1])};
   json selection;
   selection["mode"] = x.byLabel ? "label" : "iso";
-  selection[x.byLabel ? "label" : "iso"] = number(x.value);
+  selection[x.byLabel ? "label" : "iso"] = x.byLabel ? labelJson(x.label) : number(x.value);
   if (!x.byLabel) selection["iso_source"] = x.valueFromOtsu ? "otsu" : "given";
   j["selection"] = std::move(selection);
   j["adjacency"] = toString(x.pair);
@@ -410,7 +415,7 @@ void printVolumeInfo(std::ostream& out, const std::string& path, const io::Loade
         l << " ...";
         break;
       }
-      l << " " << value;
+      l << " " << value.text();
     }
     row(out, "labels", l.str());
   }
@@ -435,7 +440,7 @@ json volumeJson(const std::string& path, const io::LoadedVolume& volume, const V
   j["histogram"] = {{"bin_width", number(s.binWidth)}, {"counts", s.histogram}};
   if (!s.labels.empty()) {
     json labels = json::array();
-    for (auto [value, count] : s.labels) labels.push_back({{"value", value}, {"voxels", count}});
+    for (auto [value, count] : s.labels) labels.push_back({{"value", labelJson(value)}, {"voxels", count}});
     j["labels"] = std::move(labels);
   }
   return j;

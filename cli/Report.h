@@ -36,6 +36,9 @@ std::string num(double v, int precision = 6);
 /// when it is not finite (JSON has no NaN or infinity).
 nlohmann::ordered_json number(double v);
 
+/// A label for JSON: an exact integer (uint64 ids above 2^53 included), as JSON allows.
+nlohmann::ordered_json labelJson(const LabelValue& label);
+
 /// "c=(x,y,z) d=(x,y,z)".
 std::string surfelText(const Surfel& s);
 

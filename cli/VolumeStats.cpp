@@ -33,6 +33,8 @@ VolumeStats statsOf(const VolumeView& view) {
   VolumeStats s;
   s.integral = std::is_integral_v<T>;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0;
+  // The integer extremes in T: 64-bit ids differ where their doubles do not (2^53 + 1).
+  T least = std::numeric_limits<T>::max(), most = std::numeric_limits<T>::lowest();
   forEachValue<T>(view, [&](T v) {
     const double d = double(v);
     if (!std::isfinite(d)) {
@@ -41,6 +43,8 @@ VolumeStats statsOf(const VolumeView& view) {
     }
     lo = std::min(lo, d);
     hi = std::max(hi, d);
+    least = std::min(least, v);
+    most = std::max(most, v);
     sum += d;
   });
   s.voxels = view.dims.count() - s.nonFinite;
@@ -57,13 +61,16 @@ VolumeStats statsOf(const VolumeView& view) {
   s.histogram.assign(kBins, 0);
   // Integer data over a range of at most 2^20 values: count every value (a direct array, not a
   // map: this runs over every voxel), then list them as labels when there are at most 256.
-  const bool countValues = s.integral && hi - lo < double(1 << 20);
-  std::vector<std::size_t> valueCount(countValues ? std::size_t(hi - lo) + 1 : 0, 0);
+  // The span and the offsets in uint64 arithmetic: exact for every integer type (modular for
+  // the signed ones, whose differences are then still right).
+  const std::uint64_t span = s.integral ? std::uint64_t(most) - std::uint64_t(least) : 0;
+  const bool countValues = s.integral && span < (std::uint64_t(1) << 20);
+  std::vector<std::size_t> valueCount(countValues ? std::size_t(span) + 1 : 0, 0);
   forEachValue<T>(view, [&](T v) {
     const double d = double(v);
     if (!std::isfinite(d)) return;
     if (countValues) {
-      ++valueCount[std::size_t(d - lo)];
+      if constexpr (std::is_integral_v<T>) ++valueCount[std::size_t(std::uint64_t(v) - std::uint64_t(least))];
     } else {
       const int b = int((d - lo) / s.binWidth);
       s.histogram[std::clamp(b, 0, kBins - 1)]++;
@@ -79,7 +86,9 @@ VolumeStats statsOf(const VolumeView& view) {
     }
     if (distinct <= 256)
       for (std::size_t i = 0; i < valueCount.size(); ++i)
-        if (valueCount[i]) s.labels.emplace_back(std::int64_t(lo) + std::int64_t(i), valueCount[i]);
+        if (valueCount[i]) {
+          if constexpr (std::is_integral_v<T>) s.labels.emplace_back(T(std::uint64_t(least) + i), valueCount[i]);
+        }
   }
 
   // Otsu: the split between bins k and k + 1 maximising the between-class variance.
@@ -166,10 +175,13 @@ std::size_t countAbove(const VolumeView& volume, double s) {
   });
 }
 
-std::size_t countEqual(const VolumeView& volume, double label) {
+std::size_t countEqual(const VolumeView& volume, const LabelValue& label) {
   return visitScalarType(volume.type, [&](auto type) {
+    using T = decltype(type);
     std::size_t n = 0;
-    forEachValue<decltype(type)>(volume, [&](auto v) { n += double(v) == label; });
+    if (!label.fits<T>()) return n;
+    const T L = label.as<T>();
+    forEachValue<T>(volume, [&](T v) { n += v == L; });
     return n;
   });
 }

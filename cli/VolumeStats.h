@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "LabelValue.h"
 #include "VolumeView.h"
 
 namespace surftrack::cli {
@@ -20,8 +21,9 @@ struct VolumeStats {
   double binWidth = 1;
   /// Otsu's threshold as an iso-value s (1-voxels are f > s), inside [min, max).
   double otsu = 0;
-  /// Integer images with at most 256 distinct values: each value and its voxel count.
-  std::vector<std::pair<std::int64_t, std::size_t>> labels;
+  /// Integer images with at most 256 distinct values: each value (exact, 64-bit ids included)
+  /// and its voxel count.
+  std::vector<std::pair<LabelValue, std::size_t>> labels;
   bool integral = false;
 
   /// The value below which a fraction q of the voxels lie (from the histogram).
@@ -35,6 +37,6 @@ std::optional<std::array<double, 2>> valueRange(const VolumeView& volume);
 
 /// The number of voxels with f > s, and with f = label.
 std::size_t countAbove(const VolumeView& volume, double s);
-std::size_t countEqual(const VolumeView& volume, double label);
+std::size_t countEqual(const VolumeView& volume, const LabelValue& label);
 
 }  // namespace surftrack::cli

@@ -127,16 +127,24 @@ class TriangleListExporter final : public OpenMesh::IO::BaseExporter {
 /// SurfaceMesh (the tests compare both), but from whole arrays: OpenMesh's writer goes value by
 /// value through the exporter and the stream, about 50 MB/s on this project's machines
 /// (docs/performance.md), a large part of a seeded extraction. Several meshes go one after the
-/// other (their triangles' indices shifted); `labelled` adds an int property `label` to every
-/// vertex and face (writeLabelledTriangles). Binary, or text for writeLabelledTriangles. False if
-/// a write fails.
+/// other (their triangles' indices shifted); `labelled` adds the label to every vertex and face
+/// as writeLabelledTriangles states (one int, or two 32-bit words). Binary, or text for
+/// writeLabelledTriangles. False if a write fails.
 bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binary, const std::string& path) {
   static_assert(std::endian::native == std::endian::little, "binary_little_endian is written as is");
   std::size_t vertexCount = 0, faceCount = 0;
-  for (const LabelledMesh& m : meshes) vertexCount += m.vertices->size(), faceCount += m.triangles->size();
+  bool narrow = true, negative = false;  // every label fits int32; some label is negative
+  for (const LabelledMesh& m : meshes) {
+    vertexCount += m.vertices->size(), faceCount += m.triangles->size();
+    narrow = narrow && m.label.fits<std::int32_t>();
+    negative = negative || m.label.negative();
+  }
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) return false;
-  const std::string label = labelled ? "property int label\n" : "";
+  const std::string label = !labelled ? ""
+                            : narrow  ? "property int label\n"
+                                      : std::string("property ") + (negative ? "int" : "uint") +
+                                           " label_high\nproperty uint label_low\n";
   const std::string header = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
                              " 1.0\n" + (labelled ? "comment surftrack label surfaces: one closed surface per label\n" : "") +
                              "element vertex " + std::to_string(vertexCount) +
@@ -144,12 +152,36 @@ bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binar
                              std::to_string(faceCount) + "\nproperty list uchar int vertex_indices\n" + label +
                              "end_header\n";
   bool ok = std::fwrite(header.data(), 1, header.size(), file) == header.size();
-  const std::size_t extra = labelled ? 4 : 0;
+  const std::size_t extra = !labelled ? 0 : narrow ? 4 : 8;
+  // A label's columns: its low 32 bits (int32 when narrow), then, when wide, the high word of
+  // its two's complement (int64 for a negative label, uint64 else: exact either way).
+  struct Columns {
+    unsigned char bytes[8];
+    char text[48];
+  };
+  auto columns = [&](const LabelValue& L) {
+    Columns c{};
+    const std::uint64_t bits = L.negative() ? std::uint64_t(L.as<std::int64_t>()) : L.magnitude();
+    const auto low = std::uint32_t(bits), high = std::uint32_t(bits >> 32);
+    if (narrow) {
+      std::memcpy(c.bytes, &low, 4);
+      std::snprintf(c.text, sizeof c.text, " %d", int(std::int32_t(low)));
+    } else {
+      std::memcpy(c.bytes, &high, 4);
+      std::memcpy(c.bytes + 4, &low, 4);
+      if (negative)
+        std::snprintf(c.text, sizeof c.text, " %d %u", int(std::int32_t(high)), unsigned(low));
+      else
+        std::snprintf(c.text, sizeof c.text, " %u %u", unsigned(high), unsigned(low));
+    }
+    return c;
+  };
   constexpr std::size_t kChunk = 1 << 16;  // items per buffer
   std::vector<unsigned char> buffer(kChunk * (13 + extra));
   std::string text;
   for (const LabelledMesh& m : meshes) {
     const auto& vertices = *m.vertices;
+    const Columns L = columns(m.label);
     for (std::size_t begin = 0; ok && begin < vertices.size(); begin += kChunk) {
       const std::size_t n = std::min(kChunk, vertices.size() - begin);
       unsigned char* out = buffer.data();
@@ -158,13 +190,13 @@ bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binar
         const float p[3] = {float(vertices[v][0]), float(vertices[v][1]), float(vertices[v][2])};
         if (!binary) {
           char line[96];
-          const int length = labelled ? std::snprintf(line, sizeof line, "%.9g %.9g %.9g %d\n", p[0], p[1], p[2], m.label)
-                                      : std::snprintf(line, sizeof line, "%.9g %.9g %.9g\n", p[0], p[1], p[2]);
+          const int length = std::snprintf(line, sizeof line, "%.9g %.9g %.9g%s\n", p[0], p[1], p[2],
+                                           labelled ? L.text : "");
           text.append(line, std::size_t(length));
           continue;
         }
         std::memcpy(out, p, 12);
-        if (labelled) std::memcpy(out + 12, &m.label, 4);
+        std::memcpy(out + 12, L.bytes, extra);
       }
       ok = binary ? std::fwrite(buffer.data(), 12 + extra, n, file) == n
                   : std::fwrite(text.data(), 1, text.size(), file) == text.size();
@@ -173,6 +205,7 @@ bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binar
   std::size_t offset = 0;
   for (const LabelledMesh& m : meshes) {
     const auto& triangles = *m.triangles;
+    const Columns L = columns(m.label);
     for (std::size_t begin = 0; ok && begin < triangles.size(); begin += kChunk) {
       const std::size_t n = std::min(kChunk, triangles.size() - begin);
       unsigned char* out = buffer.data();
@@ -181,15 +214,15 @@ bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binar
         const std::int32_t t[3] = {std::int32_t(triangles[f][0] + offset), std::int32_t(triangles[f][1] + offset),
                                    std::int32_t(triangles[f][2] + offset)};
         if (!binary) {
-          char line[64];
-          const int length = labelled ? std::snprintf(line, sizeof line, "3 %d %d %d %d\n", t[0], t[1], t[2], m.label)
-                                      : std::snprintf(line, sizeof line, "3 %d %d %d\n", t[0], t[1], t[2]);
+          char line[96];
+          const int length = std::snprintf(line, sizeof line, "3 %d %d %d%s\n", t[0], t[1], t[2],
+                                           labelled ? L.text : "");
           text.append(line, std::size_t(length));
           continue;
         }
         out[0] = 3;
         std::memcpy(out + 1, t, 12);
-        if (labelled) std::memcpy(out + 13, &m.label, 4);
+        std::memcpy(out + 13, L.bytes, extra);
       }
       ok = binary ? std::fwrite(buffer.data(), 13 + extra, n, file) == n
                   : std::fwrite(text.data(), 1, text.size(), file) == text.size();

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include "LabelValue.h"
 #include <functional>
 #include <string>
 #include <vector>
@@ -31,12 +32,15 @@ void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
 struct LabelledMesh {
   const std::vector<std::array<double, 3>>* vertices;
   const std::vector<std::array<std::uint32_t, 3>>* triangles;
-  std::int32_t label;
+  LabelValue label;
 };
 
 /// Writes the meshes into one .ply (binary little-endian, or text), the vertices of each mesh in
-/// turn and its triangles' indices shifted to them, with an int property `label` on every vertex
-/// and every face: writeTriangles' binary PLY writer with one more column. Through
+/// turn and its triangles' indices shifted to them, with the label on every vertex and every
+/// face: writeTriangles' binary PLY writer with more columns. PLY has no 64-bit integer, so
+/// when every label fits int32 it is one property `int label`; otherwise two 32-bit words,
+/// `label_high` and `uint label_low`, with label = label_high * 2^32 + label_low exactly —
+/// label_high an `int` if some label is negative, else a `uint` (docs/cli.md, "labels"). Through
 /// writeFileAtomically. \throw std::invalid_argument for another extension or more than
 /// 2^31 - 1 vertices, std::runtime_error naming the path when it cannot be written.
 void writeLabelledTriangles(const std::vector<LabelledMesh>& meshes, const std::string& path, bool binary = true);

@@ -114,7 +114,7 @@ void checkLabelSurfaces(const LabelVolume& volume, const VolumeView& view, std::
   const DirectCounts direct = countDirectly(volume, background);
   ASSERT_EQ(surfaces.size(), direct.voxels.size()) << "one surface per label but the background";
   std::map<std::int64_t, const LabelSurface*> byLabel;
-  for (const LabelSurface& ls : surfaces) byLabel[std::int64_t(ls.label)] = &ls;
+  for (const LabelSurface& ls : surfaces) byLabel[ls.label.as<std::int64_t>()] = &ls;
   std::size_t k = 0;
   for (const auto& [L, voxels] : direct.voxels) {
     SCOPED_TRACE("label " + std::to_string(L));
@@ -161,7 +161,7 @@ void checkLabelSurfaces(const LabelVolume& volume, const VolumeView& view, std::
     // The binary path: this label alone.
     if (checks.binaryPath && deep && index % checks.binaryPathEvery == 0) {
       ExtractOptions options;
-      options.selection = Selection::label(double(L));
+      options.selection = Selection::label(L);
       options.seed = SeedRule::all();
       options.pair = pair;
       options.threads = 1;
@@ -276,7 +276,7 @@ void checkRandomImage(std::uint32_t seed) {
   const std::vector<T> data = typed<T>(volume);
   const VolumeView view = VolumeView::of(data.data(), volume.dims);
   LabelOptions options;
-  options.background = double(background);
+  options.background = background;
   options.pair = pair;
   options.threads = 1 + int(seed % 2);
   std::vector<LabelSurface> surfaces;
@@ -383,7 +383,7 @@ TEST(Labels, OnePlyOfEveryLabelReadsBackWithItsLabelsClosed) {
     const LabelVolume volume = randomLabels(seed, background, shape);
     const std::vector<std::int32_t> data = typed<std::int32_t>(volume);
     LabelOptions options;
-    options.background = double(background);
+    options.background = background;
     options.pair = kPairs[seed % 4];
     std::vector<LabelSurface> surfaces;
     try {
@@ -402,14 +402,14 @@ TEST(Labels, OnePlyOfEveryLabelReadsBackWithItsLabelsClosed) {
         ASSERT_LE(vertex + s.vertices.size(), ply.points.size());
         ASSERT_LE(face + s.triangles.size(), ply.faces.size());
         for (std::size_t v = 0; v < s.vertices.size(); ++v) {
-          ASSERT_EQ(ply.vertexLabels[vertex + v], std::int32_t(ls.label));
+          ASSERT_EQ(ply.vertexLabels[vertex + v], ls.label.as<std::int32_t>());
           for (int a = 0; a < 3; ++a) ASSERT_EQ(ply.points[vertex + v][a], float(s.vertices[v][a]));
         }
         // The label's faces: its label, indices among its own vertices, and every directed edge
         // once with its reverse once (closed and oriented).
         std::map<std::pair<std::int32_t, std::int32_t>, int> edges;
         for (std::size_t f = 0; f < s.triangles.size(); ++f) {
-          ASSERT_EQ(ply.faceLabels[face + f], std::int32_t(ls.label));
+          ASSERT_EQ(ply.faceLabels[face + f], ls.label.as<std::int32_t>());
           const auto& t = ply.faces[face + f];
           for (int j = 0; j < 3; ++j) {
             ASSERT_GE(t[j], std::int32_t(vertex));
@@ -442,11 +442,11 @@ TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
     const VolumeView view = VolumeView::of(data.data(), volume.dims);
     const DirectCounts direct = countDirectly(volume, background);
     if (direct.voxels.size() < 2) continue;
-    std::vector<double> present;
-    for (const auto& [L, n] : direct.voxels) present.push_back(double(L));
+    std::vector<LabelValue> present;
+    for (const auto& [L, n] : direct.voxels) present.push_back(L);
 
     LabelOptions options;
-    options.background = double(background);
+    options.background = background;
     options.labels = LabelSelection::list({present.back(), present.front(), present.back()});
     auto listed = extractLabels(view, options);
     ASSERT_EQ(listed.size(), 2u);
@@ -456,7 +456,7 @@ TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
     options.labels = LabelSelection::range(present[0], present[1]);
     auto ranged = extractLabels(view, options);
     ASSERT_EQ(ranged.size(), 2u);
-    EXPECT_EQ(ranged[1].surface.surfels.size(), direct.surfels.at(std::int64_t(present[1])).size());
+    EXPECT_EQ(ranged[1].surface.surfels.size(), direct.surfels.at(present[1].as<std::int64_t>()).size());
 
     options.labels = LabelSelection::all();
     options.boundaries = LabelBoundaries::Largest;
@@ -483,7 +483,7 @@ TEST(Labels, ListsRangesLargestAndSeedsAgreeWithTheBinaryPath) {
     for (const LabelSurface& ls : extractLabels(view, options)) {
       std::set<std::uint64_t> expected;
       for (const Voxel& v : options.seeds)
-        if (double(volume.at(v)) == ls.label) {
+        if (LabelValue(volume.at(v)) == ls.label) {
           ExtractOptions alone;
           alone.selection = Selection::label(ls.label);
           alone.seed = SeedRule::ray(v);
@@ -508,7 +508,7 @@ TEST(Labels, SmoothingKeepsEveryVertexOnItsSegmentInPhysicalSpace) {
   g.origin = {-10, 4, 7};
   g.direction = {{{0, 1, 0}, {1, 0, 0}, {0, 0, 1}}};
   LabelOptions options;
-  options.background = double(background);
+  options.background = background;
   std::vector<LabelSurface> surfaces = extractLabels(VolumeView::of(data.data(), volume.dims, g), options);
   ASSERT_FALSE(surfaces.empty()) << shape;
   std::size_t moved = 0, vertices = 0;
@@ -544,7 +544,7 @@ TEST(Labels, TheSurfacesAreTheSameForAnyNumberOfThreads) {
   const std::vector<std::uint32_t> data = typed<std::uint32_t>(volume);
   const VolumeView view = VolumeView::of(data.data(), volume.dims);
   LabelOptions options;
-  options.background = double(background);
+  options.background = background;
   options.threads = 1;
   const auto one = extractLabels(view, options);
   options.threads = 2;
@@ -554,6 +554,105 @@ TEST(Labels, TheSurfacesAreTheSameForAnyNumberOfThreads) {
     EXPECT_EQ(one[i].surface.surfels, two[i].surface.surfels);
     EXPECT_EQ(one[i].surface.triangles, two[i].surface.triangles);
   }
+}
+
+/// Labels of 64-bit images near the ends of the types and around 2^53, where doubles skip
+/// integers (2^53 + 1 rounds to 2^53): every label of a random volume is its own, exactly. The
+/// oracle counts voxels and boundary faces in T directly, never through a double.
+template <class T>
+void expectExactLabels(const std::vector<T>& ids, std::uint32_t seed) {
+  const Dims dims{9, 8, 7};
+  std::mt19937 rng(seed);
+  std::vector<T> data(dims.count());
+  for (T& v : data) v = ids[rng() % ids.size()];
+  auto at = [&](Voxel c) { return data[std::size_t(c.x + dims.nx * (c.y + dims.ny * c.z))]; };
+  std::map<T, std::uint64_t> voxels;
+  std::map<T, std::vector<std::uint64_t>> surfels;
+  const T background = ids[0];
+  for (int z = 0; z < dims.nz; ++z)
+    for (int y = 0; y < dims.ny; ++y)
+      for (int x = 0; x < dims.nx; ++x) {
+        const Voxel c{x, y, z};
+        const T L = at(c);
+        if (L == background) continue;
+        ++voxels[L];
+        for (Direction n = 0; n < 6; ++n)
+          if (!dims.contains(c + unitVector(n)) || at(c + unitVector(n)) != L) surfels[L].push_back(Surfel{c, n}.key());
+      }
+  const VolumeView view = VolumeView::of(data.data(), dims);
+  LabelOptions options;
+  options.background = background;
+  options.threads = 1;
+  const std::vector<LabelSurface> surfaces = extractLabels(view, options);
+  ASSERT_EQ(surfaces.size(), voxels.size());
+  std::size_t k = 0;
+  for (const auto& [L, count] : voxels) {
+    const LabelSurface& ls = surfaces[k++];
+    SCOPED_TRACE("label " + std::to_string(L));
+    ASSERT_EQ(ls.label, LabelValue(L));
+    ASSERT_EQ(ls.label.text(), std::to_string(L));
+    EXPECT_EQ(ls.voxels, count);
+    std::vector<std::uint64_t> keys;
+    for (const Surfel& s : ls.surface.surfels) keys.push_back(s.key());
+    std::sort(keys.begin(), keys.end());
+    std::sort(surfels[L].begin(), surfels[L].end());
+    EXPECT_EQ(keys, surfels[L]);
+    // The single-label paths select the same voxels: a scan, and a seed on one of them.
+    ExtractOptions alone;
+    alone.selection = Selection::label(L);
+    alone.seed = SeedRule::all();
+    alone.threads = 1;
+    EXPECT_EQ(extract(view, alone).surfels.size(), keys.size());
+    alone.seed = SeedRule::fromSurfel(Surfel::fromKey(keys.front()));
+    EXPECT_NO_THROW(extract(view, alone));
+    // A list of this label alone, and a range of exactly it.
+    LabelOptions one = options;
+    one.labels = LabelSelection::list({L});
+    ASSERT_EQ(extractLabels(view, one).at(0).label, LabelValue(L));
+    one.labels = LabelSelection::range(L, L);
+    ASSERT_EQ(extractLabels(view, one).size(), 1u);
+  }
+}
+
+TEST(Labels, SixtyFourBitLabelsAreExact) {
+  constexpr std::uint64_t two53 = std::uint64_t(1) << 53;
+  const std::vector<std::uint64_t> unsignedIds = {0, two53, two53 + 1, two53 + 2, 864691135501989106ULL,
+                                                  864691135501989107ULL, ~std::uint64_t(0), ~std::uint64_t(0) - 1};
+  const std::vector<std::int64_t> signedIds = {0, std::numeric_limits<std::int64_t>::min(),
+                                               std::numeric_limits<std::int64_t>::min() + 1,
+                                               std::numeric_limits<std::int64_t>::max(),
+                                               std::int64_t(two53) + 1, -std::int64_t(two53) - 1, -1};
+  for (std::uint32_t seed = 1; seed <= 40; ++seed) {
+    expectExactLabels(unsignedIds, seed);
+    expectExactLabels(signedIds, seed);
+  }
+}
+
+TEST(Labels, LabelValueParsesComparesAndConvertsExactly) {
+  EXPECT_EQ(LabelValue::parse("18446744073709551615")->magnitude(), ~std::uint64_t(0));
+  EXPECT_FALSE(LabelValue::parse("18446744073709551616"));
+  EXPECT_EQ(LabelValue::parse("-9223372036854775808")->as<std::int64_t>(), std::numeric_limits<std::int64_t>::min());
+  EXPECT_FALSE(LabelValue::parse("-9223372036854775809"));
+  EXPECT_FALSE(LabelValue::parse("1.5"));
+  EXPECT_FALSE(LabelValue::parse(""));
+  EXPECT_FALSE(LabelValue::parse("-"));
+  EXPECT_EQ(*LabelValue::parse("-0"), LabelValue(0));
+  EXPECT_FALSE(LabelValue::fromDouble(2.5));
+  EXPECT_FALSE(LabelValue::fromDouble(0x1p64));
+  EXPECT_FALSE(LabelValue::fromDouble(std::nan("")));
+  // Order: every pair of a list sorted as integers compares as its integers do.
+  const std::vector<LabelValue> sorted = {std::numeric_limits<std::int64_t>::min(), -2, -1, 0, 1,
+                                          std::numeric_limits<std::int64_t>::max(),
+                                          std::uint64_t(1) << 63, ~std::uint64_t(0)};
+  for (std::size_t a = 0; a < sorted.size(); ++a)
+    for (std::size_t b = 0; b < sorted.size(); ++b) EXPECT_EQ(sorted[a] < sorted[b], a < b) << a << " " << b;
+  EXPECT_TRUE(LabelValue(255).fits<std::uint8_t>());
+  EXPECT_FALSE(LabelValue(256).fits<std::uint8_t>());
+  EXPECT_TRUE(LabelValue(-128).fits<std::int8_t>());
+  EXPECT_FALSE(LabelValue(-129).fits<std::int8_t>());
+  EXPECT_FALSE(LabelValue(-1).fits<std::uint64_t>());
+  EXPECT_FALSE(LabelValue((std::uint64_t(1) << 53) + 1).fits<double>());
+  EXPECT_TRUE(LabelValue(std::uint64_t(1) << 53).fits<double>());
 }
 
 TEST(Labels, BadInputIsOneLineInvalidInput) {
@@ -583,8 +682,8 @@ TEST(Labels, BadInputIsOneLineInvalidInput) {
   expectMessage(o, view, "empty selection");
   o.labels = LabelSelection::list({0});
   expectMessage(o, view, "is the background");
-  o.labels = LabelSelection::list({2.5});
-  expectMessage(o, view, "not a value of uint16");
+  o.labels = LabelSelection::list({70000});
+  expectMessage(o, view, "label 70000 is not a value of uint16");
   o.labels = LabelSelection::range(4, 10);
   expectMessage(o, view, "empty selection: no label in [4, 10]");
   o.labels = LabelSelection::all();

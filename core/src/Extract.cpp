@@ -86,8 +86,7 @@ class Stages {
 };
 
 [[noreturn]] void throwEmpty(const VoxelSource&, const Selection& selection) {
-  throw InvalidInput("empty selection: no voxel has " +
-                     std::string(selection.isLabel() ? "f = " : "f > ") + numberText(selection.value, 10) +
+  throw InvalidInput("empty selection: no voxel has " + selection.text() +
                      " with a 0-voxel next to it: the image has no boundary surfel");
 }
 

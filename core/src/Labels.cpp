@@ -51,18 +51,17 @@ void forEachIndex(tbb::task_arena& arena, std::size_t n, F&& f) {
 
 /// A list selection's labels are values of the type other than the background.
 template <class T>
-void requireListable(const LabelSelection& selection, double background) {
+void requireListable(const LabelSelection& selection, const LabelValue& background) {
   if (selection.labels.empty()) throw InvalidInput("empty selection: the list of labels is empty");
-  for (double L : selection.labels) {
+  for (const LabelValue& L : selection.labels) {
     requireSelectable(scalarTypeOf<T>(), Selection::label(L));
-    if (L == background) throw InvalidInput("label " + numberText(L) + " is the background");
+    if (L == background) throw InvalidInput("label " + L.text() + " is the background");
   }
 }
 
 void requireNonEmptyRange(const LabelSelection& selection) {
-  if (std::isnan(selection.first) || std::isnan(selection.last) || selection.first > selection.last)
-    throw InvalidInput("label range [" + numberText(selection.first) + ", " + numberText(selection.last) +
-                       "] is empty");
+  if (selection.first > selection.last)
+    throw InvalidInput("label range [" + selection.first.text() + ", " + selection.last.text() + "] is empty");
 }
 
 /// Whether the scan converts label L (the selection checked by requireListable /
@@ -73,14 +72,14 @@ struct WantedLabel {
   std::vector<T> listed;  ///< List: sorted
   explicit WantedLabel(const LabelSelection& s) : selection(s) {
     if (s.kind == LabelSelection::Kind::List) {
-      for (double L : s.labels) listed.push_back(T(L));
+      for (const LabelValue& L : s.labels) listed.push_back(L.as<T>());
       std::sort(listed.begin(), listed.end());
     }
   }
   bool operator()(T L) const {
     switch (selection.kind) {
       case LabelSelection::Kind::List: return std::binary_search(listed.begin(), listed.end(), L);
-      case LabelSelection::Kind::Range: return double(L) >= selection.first && double(L) <= selection.last;
+      case LabelSelection::Kind::Range: return LabelValue(L) >= selection.first && LabelValue(L) <= selection.last;
       default: return true;
     }
   }
@@ -90,21 +89,21 @@ struct WantedLabel {
 /// in increasing order.
 template <class T>
 std::vector<std::size_t> selectLabels(const std::vector<T>& labels, const LabelSelection& selection,
-                                      double background) {
+                                      const LabelValue& background) {
   std::vector<std::size_t> out;
   switch (selection.kind) {
     case LabelSelection::Kind::All:
       out.resize(labels.size());
       std::iota(out.begin(), out.end(), std::size_t(0));
       if (out.empty())
-        throw InvalidInput("empty selection: every voxel has the background label " + numberText(background));
+        throw InvalidInput("empty selection: every voxel has the background label " + background.text());
       break;
     case LabelSelection::Kind::List:
       requireListable<T>(selection, background);
-      for (double L : selection.labels) {
-        const auto at = std::lower_bound(labels.begin(), labels.end(), T(L));
-        if (at == labels.end() || *at != T(L))
-          throw InvalidInput("label " + numberText(L) + " does not occur in the image");
+      for (const LabelValue& L : selection.labels) {
+        const auto at = std::lower_bound(labels.begin(), labels.end(), L.as<T>());
+        if (at == labels.end() || *at != L.as<T>())
+          throw InvalidInput("label " + L.text() + " does not occur in the image");
         out.push_back(std::size_t(at - labels.begin()));
       }
       std::sort(out.begin(), out.end());
@@ -113,11 +112,11 @@ std::vector<std::size_t> selectLabels(const std::vector<T>& labels, const LabelS
     case LabelSelection::Kind::Range:
       requireNonEmptyRange(selection);
       for (std::size_t i = 0; i < labels.size(); ++i)
-        if (double(labels[i]) >= selection.first && double(labels[i]) <= selection.last) out.push_back(i);
+        if (LabelValue(labels[i]) >= selection.first && LabelValue(labels[i]) <= selection.last) out.push_back(i);
       if (out.empty())
-        throw InvalidInput("empty selection: no label in [" + numberText(selection.first) + ", " +
-                           numberText(selection.last) + "] occurs in the image (background " +
-                           numberText(background) + ")");
+        throw InvalidInput("empty selection: no label in [" + selection.first.text() + ", " +
+                           selection.last.text() + "] occurs in the image (background " + background.text() +
+                           ")");
       break;
   }
   return out;
@@ -145,11 +144,11 @@ std::vector<std::vector<std::size_t>> wantedSeeds(const VolumeRef<T>& image, con
       throw InvalidInput(msg.str());
     }
     const T L = image.at(v);
-    if (double(L) == o.background)
-      throw InvalidInput("seed voxel " + voxelText(v) + " is on the background label " + numberText(o.background));
+    if (LabelValue(L) == o.background)
+      throw InvalidInput("seed voxel " + voxelText(v) + " is on the background label " + o.background.text());
     const std::size_t i = std::size_t(std::lower_bound(seeds.labels.begin(), seeds.labels.end(), L) - seeds.labels.begin());
     if (!std::binary_search(selected.begin(), selected.end(), i))
-      throw InvalidInput("seed voxel " + voxelText(v) + " has label " + numberText(double(L)) +
+      throw InvalidInput("seed voxel " + voxelText(v) + " has label " + LabelValue(L).text() +
                          ", which is not selected");
     // The +x ray from the seed: its first 1 -> 0 step, the surfel (c, c + x) of the last voxel c
     // of L on it (the ray leaves the domain, so there is one).
@@ -174,18 +173,9 @@ void append(TriangleMesh& to, TriangleMesh&& from) {
   for (auto t : from.triangles) to.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
 }
 
-/// Labels are exact as doubles (the front door's selections and results are doubles).
-template <class T>
-void requireExactLabels(const std::vector<T>& labels) {
-  if constexpr (sizeof(T) == 8)
-    for (T L : labels)
-      if (!(std::abs(double(L)) <= std::ldexp(1.0, 53)))
-        throw InvalidInput("label " + std::to_string(L) + " is beyond 2^53: labels must be exact as doubles");
-}
-
 /// The fields of a label's result that do not depend on how its mesh was made (but the
 /// vertices, triangles and surfels).
-LabelSurface labelFields(const VoxelSource& source, double label, std::uint64_t voxels, const LabelOptions& o) {
+LabelSurface labelFields(const VoxelSource& source, LabelValue label, std::uint64_t voxels, const LabelOptions& o) {
   LabelSurface result;
   result.label = label;
   result.voxels = voxels;
@@ -198,7 +188,7 @@ LabelSurface labelFields(const VoxelSource& source, double label, std::uint64_t 
 }
 
 /// A label's result from its converted mesh, placed by the midpoint mapping.
-LabelSurface labelSurface(const VoxelSource& source, double label, std::uint64_t voxels, TriangleMesh&& mesh,
+LabelSurface labelSurface(const VoxelSource& source, LabelValue label, std::uint64_t voxels, TriangleMesh&& mesh,
                           const LabelOptions& o) {
   LabelSurface result = labelFields(source, label, voxels, o);
   Surface& s = result.surface;
@@ -217,10 +207,9 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   if (o.labels.kind == LabelSelection::Kind::List) requireListable<T>(o.labels, o.background);
   if (o.labels.kind == LabelSelection::Kind::Range) requireNonEmptyRange(o.labels);
   const WantedLabel<T> wanted(o.labels);
-  LabelSurfaceScan<T, WantedLabel<T>> scan(image, T(o.background), wanted, o.pair, arena, parts);
+  LabelSurfaceScan<T, WantedLabel<T>> scan(image, o.background.as<T>(), wanted, o.pair, arena, parts);
   const LabelCounts<T>& counts = scan.counts();
 
-  requireExactLabels(counts.labels);
   const std::vector<std::size_t> selected = selectLabels(counts.labels, o.labels, o.background);
   // The scan kept the wanted labels only, and selectLabels checked that each listed one occurs.
   if (selected.size() != counts.labels.size()) throw InternalError("the label scan kept labels not selected");
@@ -231,7 +220,7 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   std::vector<LabelSurface> out(n);
   std::vector<LabelMeshArrays> arrays(n);
   forEachIndex(arena, n, [&](std::size_t i) {
-    out[i] = labelFields(source, double(counts.labels[i]), counts.voxels[i], o);
+    out[i] = labelFields(source, LabelValue(counts.labels[i]), counts.voxels[i], o);
     Surface& s = out[i].surface;
     s.vertices.resize(counts.surfels[i]);
     s.surfels.resize(counts.surfels[i]);
@@ -263,8 +252,8 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
 
 template <class T>
 std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource& source, const LabelOptions& o) {
-  if (!holdsValue<T>(o.background))
-    throw InvalidInput("background " + numberText(o.background) + " is not a value of " +
+  if (!o.background.fits<T>())
+    throw InvalidInput("background " + o.background.text() + " is not a value of " +
                        toString(scalarTypeOf<T>()) + " voxels");
   const Dims dims = view.dims;
   const VolumeRef<T> image(static_cast<const T*>(view.data), dims, view.strides[0], view.strides[1], view.strides[2]);
@@ -281,10 +270,9 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
   forEachIndex(arena, slabs.size(), [&](std::size_t k) {
     const int z0 = int(std::int64_t(dims.nz) * std::int64_t(k) / std::int64_t(slabs.size()));
     const int z1 = int(std::int64_t(dims.nz) * std::int64_t(k + 1) / std::int64_t(slabs.size()));
-    slabs[k] = scanLabelSeeds(image, T(o.background), z0, z1);
+    slabs[k] = scanLabelSeeds(image, o.background.as<T>(), z0, z1);
   });
   LabelSeeds<T> seeds = mergeLabelSeeds(std::move(slabs));
-  requireExactLabels(seeds.labels);
 
   std::vector<std::size_t> selected = selectLabels(seeds.labels, o.labels, o.background);
   const std::vector<std::vector<std::size_t>> wanted = wantedSeeds(image, seeds, selected, o);
@@ -301,7 +289,7 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
   forEachIndex(arena, order.size(), [&](std::size_t k) {
     if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
     const std::size_t r = order[k], i = selected[r];
-    const Selection selection = Selection::label(double(seeds.labels[i]));
+    const Selection selection = Selection::label(LabelValue(seeds.labels[i]));
     const SourceImage binary(source, selection);
     TriangleMesh mesh;
     std::optional<SurfaceGraph> largest;
@@ -326,7 +314,7 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
       throw InternalError(e.what());
     }
     std::vector<std::uint64_t>().swap(seeds.surfels[i]);  // done with them: the output grows
-    out[r] = labelSurface(source, selection.value, seeds.voxels[i], std::move(mesh), o);
+    out[r] = labelSurface(source, selection.labelValue, seeds.voxels[i], std::move(mesh), o);
     out[r].surface.boundariesInImage = fromSeeds ? 0 : boundaries;
   });
   return out;
@@ -339,7 +327,6 @@ std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptio
     throw InvalidInput("a label image needs integer voxels: this one has " + toString(view.type) + " voxels");
   if (options.threads < 0)
     throw InvalidInput("threads " + std::to_string(options.threads) + " is negative (0: all cores)");
-  if (std::isnan(options.background)) throw InvalidInput("background is NaN");
   const std::unique_ptr<VoxelSource> source = makeViewSource(view);  // checks the view
   return visitScalarType(view.type, [&](auto zero) -> std::vector<LabelSurface> {
     using T = decltype(zero);

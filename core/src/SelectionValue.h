@@ -21,31 +21,22 @@ inline std::string numberText(double v, int precision = 17) {
   return s.str();
 }
 
-/// Whether `value` is exactly a value of T (integers: in range and integral; floats: finite).
-template <class T>
-bool holdsValue(double value) {
-  if constexpr (std::is_integral_v<T>)
-    // max + 1 is a power of two, exact as a double (max itself may not be: 2^64 - 1).
-    return value == std::floor(value) && value >= double(std::numeric_limits<T>::lowest()) &&
-           value < std::ldexp(1.0, std::numeric_limits<T>::digits);
-  else
-    return std::isfinite(value);
-}
-
 /// The label of a label selection as a T (checked by requireSelectable beforehand).
 template <class T>
 T selectionValue(const Selection& selection) {
-  return T(selection.value);
+  return selection.labelValue.as<T>();
+}
+
+/// Whether label L is a value of voxels of `type`.
+inline bool holdsLabel(ScalarType type, const LabelValue& L) {
+  return visitScalarType(type, [&](auto v) { return L.fits<decltype(v)>(); });
 }
 
 /// Throws InvalidInput unless `selection` means something for voxels of `type`.
 inline void requireSelectable(ScalarType type, const Selection& selection) {
-  if (std::isnan(selection.value))
-    throw InvalidInput(std::string(selection.isLabel() ? "label" : "iso-value") + " is NaN");
-  if (selection.isLabel() &&
-      !visitScalarType(type, [&](auto v) { return holdsValue<decltype(v)>(selection.value); }))
-    throw InvalidInput("label " + numberText(selection.value) + " is not a value of " + toString(type) +
-                       " voxels");
+  if (!selection.isLabel() && std::isnan(selection.value)) throw InvalidInput("iso-value is NaN");
+  if (selection.isLabel() && !holdsLabel(type, selection.labelValue))
+    throw InvalidInput("label " + selection.labelValue.text() + " is not a value of " + toString(type) + " voxels");
 }
 
 }  // namespace surftrack

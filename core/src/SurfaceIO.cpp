@@ -2,7 +2,6 @@
 // writeLabelSurfaces: label surfaces as one PLY with label properties, through the same binary
 // PLY writer (converter/MeshIO.h writeLabelledTriangles).
 #include <cstdint>
-#include <limits>
 #include <stdexcept>
 
 #include "Errors.h"
@@ -31,21 +30,10 @@ void writeSurface(const Surface& surface, const std::string& path, bool binary) 
   }
 }
 
-namespace {
-
-/// A label as the PLY int property (labels beyond int32 do not fit it).
-std::int32_t plyLabel(double label) {
-  if (!(label >= std::numeric_limits<std::int32_t>::min() && label <= std::numeric_limits<std::int32_t>::max()))
-    throw InvalidInput("label " + numberText(label) + " does not fit the PLY int label property");
-  return std::int32_t(label);
-}
-
-}  // namespace
-
 void writeLabelSurfaces(const std::vector<LabelSurface>& surfaces, const std::string& path, bool binary) {
   std::vector<LabelledMesh> meshes;
   for (const LabelSurface& ls : surfaces)
-    meshes.push_back({&ls.surface.vertices, &ls.surface.triangles, plyLabel(ls.label)});
+    meshes.push_back({&ls.surface.vertices, &ls.surface.triangles, ls.label});
   try {
     writeLabelledTriangles(meshes, path, binary);
   } catch (const std::invalid_argument& e) {

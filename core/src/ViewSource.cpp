@@ -72,7 +72,8 @@ class FunctionSource final : public VoxelSource {
     for (int i = 0; i < count; ++i) {
       if (!dims_.contains(start.x + i, start.y, start.z)) continue;
       const double f = f_(start.x + i, start.y, start.z);
-      const bool one = selection.isLabel() ? f == selection.value : f > selection.value;
+      // A label selection reached here fits a double (requireSelectable): exact comparison.
+      const bool one = selection.isLabel() ? f == selection.labelValue.toDouble() : f > selection.value;
       bits |= std::uint64_t(one) << i;
     }
     return bits;

@@ -1,6 +1,8 @@
 // _surftrack: the Python binding of the front door (docs/python.md). It only translates: numpy
 // arrays to VolumeViews (no copy), Python arguments to ExtractOptions, a Surface to numpy
 // arrays. The axis handling and the defaults live in surftrack/__init__.py.
+#include <cmath>
+
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -14,6 +16,42 @@ namespace py = pybind11;
 using namespace surftrack;
 
 namespace {
+
+/// A Python label as the engine's exact LabelValue: an int (or anything with __index__: numpy's
+/// integer scalars), exact up to 64 bits — segment ids far above 2^53 stay themselves; a float
+/// only when it is an integer of at most 2^53, where it is still exact.
+LabelValue labelOf(py::handle h, const char* what) {
+  const std::string text = py::repr(h).cast<std::string>();
+  if (PyFloat_Check(h.ptr())) {
+    const double v = PyFloat_AsDouble(h.ptr());
+    if (std::fabs(v) <= 0x1p53)
+      if (const auto L = LabelValue::fromDouble(v)) return *L;
+    throw py::value_error(std::string(what) + " " + text + " is not an integer (labels are integers; " +
+                          "give ints beyond 2^53, where floats skip integers)");
+  }
+  PyObject* index = PyNumber_Index(h.ptr());
+  if (!index) {
+    PyErr_Clear();
+    throw py::type_error(std::string(what) + " must be an integer, not " + text);
+  }
+  const py::object n = py::reinterpret_steal<py::object>(index);
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(index, &overflow);
+  if (overflow == 0 && !PyErr_Occurred()) return LabelValue(v);
+  PyErr_Clear();
+  if (overflow > 0) {
+    const unsigned long long u = PyLong_AsUnsignedLongLong(index);
+    if (!PyErr_Occurred()) return LabelValue(u);
+    PyErr_Clear();
+  }
+  throw py::value_error(std::string(what) + " " + text + " is beyond 64 bits: no voxel type holds it");
+}
+
+/// A label as a Python int, exactly.
+py::int_ labelObject(const LabelValue& L) {
+  if (L.negative()) return py::int_(L.as<std::int64_t>());
+  return py::reinterpret_steal<py::int_>(PyLong_FromUnsignedLongLong(L.magnitude()));
+}
 
 /// The ScalarType of a numpy dtype; throws TypeError for anything but the ten types.
 ScalarType scalarTypeOfDtype(const py::dtype& dtype) {
@@ -139,7 +177,7 @@ py::dict surfaceDict(const std::shared_ptr<Result>& r) {
 
 /// Runs extract() on `volume` whose engine axes x, y, z are the array axes order[0..2].
 py::dict extractArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
-                      double value, const std::string& seedKind, std::array<double, 6> seed,
+                      py::object value, const std::string& seedKind, std::array<double, 6> seed,
                       const std::string& adjacency, const std::string& mapping, double epsilon,
                       std::array<double, 3> spacing, std::array<double, 3> origin,
                       std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
@@ -147,7 +185,8 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
                       std::optional<double> reduction) {
   const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
   ExtractOptions o;
-  o.selection = selectionKind == "label" ? Selection::label(value) : Selection::threshold(value);
+  o.selection = selectionKind == "label" ? Selection::label(labelOf(value, "label"))
+                                         : Selection::threshold(value.cast<double>());
   o.pair = parseAdjacencyPair(adjacency);
   o.mapping = parseMapping(mapping);
   o.epsilon = epsilon;
@@ -234,16 +273,21 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
 
 /// Runs extractLabels() on `volume` (engine axes order[0..2]): a dict label -> surfaceDict.
 py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
-                            std::vector<double> labels, std::array<double, 2> range, double background,
+                            py::list labels, py::list range, py::object background,
                             const std::string& boundaries, std::vector<std::array<int, 3>> seeds,
                             const std::string& adjacency, std::array<double, 3> spacing,
                             std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
                             int threads, bool figures) {
   const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
   LabelOptions o;
-  if (selectionKind == "list") o.labels = LabelSelection::list(std::move(labels));
-  else if (selectionKind == "range") o.labels = LabelSelection::range(range[0], range[1]);
-  o.background = background;
+  if (selectionKind == "list") {
+    std::vector<LabelValue> list;
+    for (py::handle L : labels) list.push_back(labelOf(L, "label"));
+    o.labels = LabelSelection::list(std::move(list));
+  } else if (selectionKind == "range") {
+    o.labels = LabelSelection::range(labelOf(range[0], "label_range's first"), labelOf(range[1], "label_range's last"));
+  }
+  o.background = labelOf(background, "background");
   o.boundaries = boundaries == "largest" ? LabelBoundaries::Largest : LabelBoundaries::All;
   for (const auto& a : seeds) {
     Voxel v;
@@ -265,7 +309,7 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
     r->surface = std::move(ls.surface);
     py::dict d = surfaceDict(r);
     d["voxels"] = ls.voxels;
-    out[py::int_(std::int64_t(ls.label))] = d;
+    out[labelObject(ls.label)] = d;
   }
   return out;
 }

@@ -157,7 +157,7 @@ def _range_note(array: np.ndarray, level: float) -> str:
     return ""
 
 
-def extract(volume, *, level: Optional[float] = None, label: Optional[float] = None,
+def extract(volume, *, level: Optional[float] = None, label: Optional[int] = None,
             seed: Optional[Sequence] = None, seed_point: Optional[Sequence[float]] = None,
             mode: str = "seed", seed_rule: str = "nearest", adjacency: str = "26-6",
             mapping: str = "default",
@@ -237,7 +237,8 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[float] = N
         # The scan reads every voxel row by row: one C-ordered copy is faster than reading
         # across memory, and it is read once anyway (a seeded extraction never copies).
         array = np.ascontiguousarray(array)
-    kind, value = ("label", float(label)) if label is not None else ("threshold", float(level))
+    # A label goes to the engine as it is (an int stays exact beyond 2^53); a level as a float.
+    kind, value = ("label", label) if label is not None else ("threshold", float(level))
     try:
         out = _surftrack.extract_array(array, order, kind, value, seed_kind, seed_values,
                                        adjacency, mapping, float(epsilon), spacing, origin,
@@ -285,11 +286,15 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     if adjacency not in _ADJACENCIES:
         raise ValueError(f"unsupported adjacency pair '{adjacency}': expected one of "
                          + ", ".join(_ADJACENCIES))
-    kind, values, bounds = "all", [], (0.0, 0.0)
+    # Labels reach the engine as Python ints (tolist() turns numpy integers into ints), never
+    # through float: uint64 segment ids above 2^53 stay exact.
+    kind, values, bounds = "all", [], []
     if only is not None:
-        kind, values = "list", [float(v) for v in np.asarray(only).reshape(-1)]
+        kind = "list"
+        values = np.asarray(only).reshape(-1).tolist() if isinstance(only, np.ndarray) else \
+            (list(only) if isinstance(only, (list, tuple, range)) else [only])
     elif label_range is not None:
-        r = tuple(float(v) for v in label_range)
+        r = list(label_range.tolist() if isinstance(label_range, np.ndarray) else label_range)
         if len(r) != 2:
             raise ValueError(f"label_range must be (first, last), not {label_range!r}")
         kind, bounds = "range", r
@@ -303,7 +308,7 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     # The axes as in extract(); the scan reads rows, so a C-ordered copy if need be.
     if not array.flags.c_contiguous:
         array = np.ascontiguousarray(array)
-    out = _surftrack.label_surfaces_array(array, [2, 1, 0], kind, values, bounds, float(background),
+    out = _surftrack.label_surfaces_array(array, [2, 1, 0], kind, values, bounds, background,
                                           boundaries, seed_list, adjacency, spacing, origin,
                                           direction.tolist(), int(threads), bool(figures))
     return {label: Surface(**fields) for label, fields in out.items()}

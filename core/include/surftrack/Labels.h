@@ -19,6 +19,7 @@
 
 #include "AdjacencyPair.h"
 #include "Extract.h"
+#include "LabelValue.h"
 #include "VolumeView.h"
 #include "Voxel.h"
 
@@ -32,12 +33,12 @@ struct LabelSelection {
     Range   ///< the labels of the image in [first, last]; at least one must occur
   };
   Kind kind = Kind::All;
-  std::vector<double> labels;  ///< List
-  double first = 0, last = 0;  ///< Range, inclusive
+  std::vector<LabelValue> labels;  ///< List
+  LabelValue first, last;          ///< Range, inclusive
 
   static LabelSelection all() { return {}; }
-  static LabelSelection list(std::vector<double> labels) { return {Kind::List, std::move(labels), 0, 0}; }
-  static LabelSelection range(double first, double last) { return {Kind::Range, {}, first, last}; }
+  static LabelSelection list(std::vector<LabelValue> labels) { return {Kind::List, std::move(labels), {}, {}}; }
+  static LabelSelection range(LabelValue first, LabelValue last) { return {Kind::Range, {}, first, last}; }
 };
 
 /// Which boundaries of each label to extract, when LabelOptions::seeds is empty (seeds select
@@ -50,7 +51,7 @@ enum class LabelBoundaries {
 struct LabelOptions {
   LabelSelection labels;
   /// The label of no surface: its voxels are 0-voxels of every label.
-  double background = 0;
+  LabelValue background = 0;
   LabelBoundaries boundaries = LabelBoundaries::All;
   /// If not empty, only the boundaries these voxels select, and only their labels: each voxel,
   /// of label L, selects the boundary of L through the surfel (c, c + x) where c is the last
@@ -70,28 +71,30 @@ struct LabelOptions {
 
 /// The surface of one label: its boundaries wanted, one component each.
 struct LabelSurface {
-  double label = 0;
+  LabelValue label;  ///< exact, as every label here (LabelValue.h)
   std::uint64_t voxels = 0;  ///< voxels of the label in the image
   /// selection = Selection::label(label), mapping Midpoint; boundariesInImage: every boundary
   /// of the label for LabelBoundaries::All and Largest, 0 (not counted) with seeds.
   Surface surface;
 };
 
-/// The surfaces of the selected labels of `view`, by increasing label.
-/// \pre the labels of the image are exactly representable as doubles (|L| <= 2^53).
+/// The surfaces of the selected labels of `view`, by increasing label. Labels are exact over
+/// the whole range of every integer type (uint64 ids above 2^53 included).
 /// \throw InvalidInput for a float volume, a selected label that is not a value of the type,
 ///        does not occur or is the background, a range or an image with no label to extract,
 ///        a seed outside the domain or on the background or an unselected label, seeds with
-///        LabelBoundaries::Largest, a label beyond 2^53.
+///        LabelBoundaries::Largest.
 /// \throw Cancelled when options.cancel is raised.
 /// \throw InternalError when an engine invariant fails (a bug).
 std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options);
 
 /// Writes every surface into one PLY file (binary little-endian, or text): the vertices of each
 /// label in turn (float x, y, z; a vertex on an interface once per label it bounds), the faces
-/// (int indices), with an int property `label` on every vertex and every face. Through a
-/// temporary file renamed over `path`.
-/// \throw InvalidInput for a label beyond int32 or more than 2^31 - 1 vertices;
+/// (int indices), with the label on every vertex and every face, exactly: an int property
+/// `label` when every label fits int32, else `label_high` and `uint label_low` with
+/// label = label_high * 2^32 + label_low (label_high an int if a label is negative, else a uint).
+/// Through a temporary file renamed over `path`.
+/// \throw InvalidInput for more than 2^31 - 1 vertices;
 ///        std::runtime_error naming the path when it cannot be written.
 void writeLabelSurfaces(const std::vector<LabelSurface>& surfaces, const std::string& path, bool binary = true);
 

@@ -9,8 +9,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <sstream>
+#include <string>
 
 #include "Geometry.h"
+#include "LabelValue.h"
 #include "ScalarType.h"
 #include "VolumeView.h"
 #include "Voxel.h"
@@ -21,11 +24,20 @@ namespace surftrack {
 struct Selection {
   enum class Kind { Threshold, Label };
   Kind kind = Kind::Threshold;
-  double value = 0;
+  double value = 0;   ///< Threshold: s
+  LabelValue labelValue;  ///< Label: L, exact (64-bit segment ids included)
 
-  static Selection threshold(double s) { return {Kind::Threshold, s}; }
-  static Selection label(double L) { return {Kind::Label, L}; }
+  static Selection threshold(double s) { return {Kind::Threshold, s, {}}; }
+  static Selection label(LabelValue L) { return {Kind::Label, 0, L}; }
   bool isLabel() const { return kind == Kind::Label; }
+  /// "f > s" or "f = L", for messages (s with 10 significant digits, L exactly).
+  std::string text() const {
+    if (isLabel()) return "f = " + labelValue.text();
+    std::ostringstream s;
+    s.precision(10);
+    s << "f > " << value;
+    return s.str();
+  }
 };
 
 /// Every member is const and may be called from several threads at once (the scanning method
