@@ -52,6 +52,8 @@ void describeInput(const io::LoadedVolume& volume, const std::string& path, Extr
                                     : (volume.mapped ? "memory-mapped " : "loaded ") + volume.format;
   x.mapped = volume.mapped;
   x.decodeReason = volume.decodeReason;
+  x.frame = volume.frame;
+  x.warnings.insert(x.warnings.end(), volume.warnings.begin(), volume.warnings.end());
   x.voxelBytes = volume.view.dims.count() * sizeOf(volume.view.type);
 }
 
@@ -59,8 +61,17 @@ io::LoadedVolume readInput(const InputOptions& input) {
   io::LoadedVolume volume = input.raw ? io::loadRawVolume(input.path, input.rawLayout)
                                       : io::loadVolume(input.path);
   ImageGeometry& g = volume.view.geometry;
+  if (input.ras) {
+    // RAS = diag(-1, -1, 1) LPS: the origin and the direction's x and y rows negated. The
+    // handedness flips with them; the engine keeps the normals outwards (Extract.h, Surface).
+    for (int r = 0; r < 2; ++r) {
+      g.origin[r] = -g.origin[r];
+      for (double& d : g.direction[r]) d = -d;
+    }
+    volume.frame = "RAS";
+  }
   if (input.spacing) g.spacing = *input.spacing;
-  if (input.origin) g.origin = *input.origin;
+  if (input.origin) g.origin = *input.origin;  // in the chosen frame
   return volume;
 }
 
@@ -183,7 +194,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   } catch (const InvalidInput& e) {
     explainNoSurface(volume, x, e.what());
   }
-  x.warnings = surface.warnings;
+  x.warnings.insert(x.warnings.end(), surface.warnings.begin(), surface.warnings.end());
   x.seedDistance = surface.seed.distance;
   for (const StageTime& t : surface.timings) x.timings.push_back({t.stage, t.seconds});
   clock.skip();  // the core timed its own stages

@@ -70,6 +70,7 @@ struct Extraction {
   std::optional<std::uintmax_t> voxelBytesResident;
 
   // The binary image and the surface options.
+  std::string frame = "LPS";      ///< of the physical coordinates (LoadedVolume::frame)
   bool byLabel = false;
   double value = 0;               ///< the iso-value
   LabelValue label;               ///< the label (byLabel)

@@ -13,6 +13,8 @@ namespace surftrack::cli {
 int runInfo(const std::vector<std::string>& args) {
   const InfoOptions o = parseInfoOptions(args);
   const io::LoadedVolume volume = readInput(o.input);
+  if (!o.out.quiet)
+    for (const std::string& w : volume.warnings) std::cerr << "surftrack: warning: " << w << "\n";
   const VolumeStats stats = computeStats(volume.view);
   if (o.out.json) {
     std::cout << jsonText(volumeJson(o.input.path, volume, stats)) << std::endl;

@@ -99,6 +99,8 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   run.namesFile = namesFile;
   std::vector<StageTiming>& timings = run.timings;
   const io::LoadedVolume volume = readInput(o.input);  // mapped or decoded, never copied
+  if (!o.out.quiet)
+    for (const std::string& w : volume.warnings) std::cerr << "surftrack: warning: " << w << "\n";
   clock.lap(timings, "read");
   const VolumeView& view = volume.view;
 

@@ -282,6 +282,13 @@ InputArgs addInputOptions(CLI::App& app, InputOptions& in) {
       "the physical position of voxel (0,0,0), instead of the file's")
       ->check(tripleOf({kNumber}, "expected three numbers X,Y,Z"))
       ->group("geometry override");
+  addValue(
+      app, "--frame", "lps|ras", [&in](const std::string& s) { in.ras = s == "ras" || s == "RAS"; },
+      "the frame of physical coordinates (outputs, --seed-point, --origin):\n"
+      "lps (default: ITK's and DICOM's) or ras (nibabel's, MNI's: x and y negated)")
+      ->check(explained(CLI::IsMember({"lps", "ras", "LPS", "RAS"}),
+                        [](const std::string& s) { return "expected lps or ras, got '" + s + "'"; }))
+      ->group("geometry override");
   return a;
 }
 

@@ -34,6 +34,7 @@ struct InputOptions {
   io::RawLayout rawLayout;       ///< --raw-dims, --raw-type, --raw-endian, --raw-header
   std::optional<std::array<double, 3>> spacing;  ///< --spacing
   std::optional<std::array<double, 3>> origin;   ///< --origin
+  bool ras = false;  ///< --frame ras: physical coordinates in RAS (nibabel, MNI), not ITK's LPS
 };
 
 enum class SeedMode { Largest, All, Voxel, Ray, Surfel, Point };

@@ -273,6 +273,7 @@ json extractionJson(const Extraction& x) {
   const MeshStats& m = x.stats;
   json j;
   j["input"] = x.input;
+  j["frame"] = x.frame;
   j["dims"] = {x.dims.nx, x.dims.ny, x.dims.nz};
   j["type"] = io::toString(x.type);
   j["spacing"] = numbers(x.geometry.spacing);
@@ -387,7 +388,7 @@ void printVolumeInfo(std::ostream& out, const std::string& path, const io::Loade
   row(out, "size", std::to_string(d.nx) + " x " + std::to_string(d.ny) + " x " + std::to_string(d.nz) +
                        " = " + std::to_string(d.count()) + " voxels of " + io::toString(volume.view.type));
   row(out, "spacing", tripleText(g.spacing));
-  row(out, "origin", tripleText(g.origin));
+  row(out, "origin", tripleText(g.origin) + " (" + volume.frame + " frame)");
   row(out, "direction", directionText(g));
   std::array<double, 3> far = g.toPhysical({double(d.nx - 1), double(d.ny - 1), double(d.nz - 1)});
   row(out, "extent", "voxel centres from " + tripleText(g.origin) + " to " + tripleText(far));
@@ -426,6 +427,8 @@ json volumeJson(const std::string& path, const io::LoadedVolume& volume, const V
   const ImageGeometry& g = volume.view.geometry;
   json j;
   j["input"] = path;
+  j["frame"] = volume.frame;
+  j["warnings"] = volume.warnings;
   j["dims"] = {d.nx, d.ny, d.nz};
   j["type"] = io::toString(volume.view.type);
   j["spacing"] = numbers(g.spacing);

@@ -29,11 +29,13 @@
 #include "LoadVolume.h"
 
 #include <algorithm>
+#include <cmath>
 #include <bit>
 #include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 
 #include "Deflate.h"
 #include "HeaderText.h"
@@ -233,7 +235,68 @@ void LoadedVolume::advise(Access access) const {
   if (mapped) detail::adviseAccess(view.data, dataBytes, access == Access::Sparse);
 }
 
+namespace {
+
+double largestDifference(const std::array<std::array<double, 4>, 3>& a, const std::array<std::array<double, 4>, 3>& b) {
+  double d = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) d = std::max(d, std::abs(a[i][j] - b[i][j]));
+  return d;
+}
+
+/// A NIfTI-1 file whose qform and sform disagree: the line that says which one the geometry
+/// follows (ITK's choice, found by comparing ITK's geometry with both), since nibabel's
+/// `affine` (the sform) and other readers would place the volume elsewhere.
+std::optional<std::string> formsWarning(const std::string& path, const ImageGeometry& g) {
+  std::string head;
+  try {
+    const detail::OpenFile file(path, "cannot read " + quoted(path));
+    if (hasSuffix(path, ".nii.gz")) {
+      head.assign(348, '\0');
+      head.resize(detail::inflateGzipPrefix(file, reinterpret_cast<unsigned char*>(head.data()), head.size(), false));
+    } else {
+      head = file.head(348);
+    }
+  } catch (const std::exception&) {
+    return std::nullopt;  // (the volume was read: a second look at its header is only a courtesy)
+  }
+  const std::optional<NiftiForms> forms = niftiForms(head);
+  if (!forms) return std::nullopt;
+  double size = 1;
+  for (const auto& row : forms->sform)
+    for (double v : row) size = std::max(size, std::abs(v));
+  if (largestDifference(forms->qform, forms->sform) <= 1e-4 * size) return std::nullopt;
+  // ITK's geometry as a RAS affine: RAS = diag(-1, -1, 1) LPS.
+  std::array<std::array<double, 4>, 3> itk{};
+  for (int i = 0; i < 3; ++i) {
+    const double sign = i < 2 ? -1.0 : 1.0;
+    for (int j = 0; j < 3; ++j) itk[i][j] = sign * g.direction[i][j] * g.spacing[j];
+    itk[i][3] = sign * g.origin[i];
+  }
+  const bool qform = largestDifference(itk, forms->qform) <= largestDifference(itk, forms->sform);
+  auto at = [](const std::array<std::array<double, 4>, 3>& m) {
+    std::ostringstream s;
+    s.precision(6);
+    s << "(" << m[0][3] << ", " << m[1][3] << ", " << m[2][3] << ")";
+    return s.str();
+  };
+  return quoted(path) + ": its qform and sform disagree (voxel (0,0,0) at RAS " + at(forms->qform) +
+         " by the qform, " + at(forms->sform) + " by the sform); the geometry follows the " +
+         (qform ? "qform" : "sform") + ", as ITK reads it (nibabel's affine is the sform)";
+}
+
+}  // namespace
+
+static LoadedVolume loadFile(const std::string& path);
+
 LoadedVolume loadVolume(const std::string& path) {
+  LoadedVolume out = loadFile(path);
+  if (hasSuffix(path, ".nii") || hasSuffix(path, ".nii.gz"))
+    if (auto w = formsWarning(path, out.view.geometry)) out.warnings.push_back(std::move(*w));
+  return out;
+}
+
+static LoadedVolume loadFile(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read " + quoted(path) + ": no such file");
   if (hasSuffix(path, ".nii.gz") && !fs::is_directory(path, ec)) {

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "ReadVolume.h"
 #include "VolumeView.h"
@@ -46,6 +47,13 @@ struct LoadedVolume {
   /// "its voxels are gzip-encoded", "its voxels at byte 301 are not aligned to their 2-byte
   /// int16 values", ...
   std::string decodeReason;
+  /// The frame of the geometry's physical coordinates: "LPS" as ITK reads every format (x
+  /// towards the patient's left, y posterior, z superior); the CLI's --frame ras makes it "RAS",
+  /// nibabel's and MNI's convention (x and y negated).
+  std::string frame = "LPS";
+  /// Things the reader of the file should know about its geometry, one line each (a NIfTI
+  /// whose qform and sform disagree).
+  std::vector<std::string> warnings;
 
   /// Bytes of voxel data resident in memory now: for a mapping, the pages that mincore()
   /// reports resident — on Linux that is the file's pages in the page cache, whether or not

@@ -172,4 +172,37 @@ std::optional<DataLayout> parseNifti1Header(std::string_view head, std::uint64_t
   return layout;
 }
 
+std::optional<NiftiForms> niftiForms(std::string_view head) {
+  if (head.size() < kHeaderSize) return std::nullopt;
+  std::int32_t sizeofHdr = 0;
+  std::memcpy(&sizeofHdr, head.data(), 4);
+  const Reader r(head, sizeofHdr != 348);
+  if (r.get<std::int16_t>(252) <= 0 || r.get<std::int16_t>(254) <= 0) return std::nullopt;
+  NiftiForms f;
+  // The qform (nifti1.h, method 2): R from the quaternion (b, c, d), a = sqrt(1 - b^2 - c^2 -
+  // d^2), times diag(dx, dy, qfac dz), then the offsets.
+  double b = r.get<float>(256), c = r.get<float>(260), d = r.get<float>(264);
+  double a = 1.0 - (b * b + c * c + d * d);
+  if (a < 1e-7) {  // (as niftilib: a unit quaternion with a = 0, the rest normalised)
+    const double n = std::sqrt(b * b + c * c + d * d);
+    if (n > 0) b /= n, c /= n, d /= n;
+    a = 0;
+  } else {
+    a = std::sqrt(a);
+  }
+  auto positive = [](double v) { return v > 0 ? v : 1.0; };
+  const double qfac = r.get<float>(76) < 0 ? -1.0 : 1.0;
+  const double dx = positive(r.get<float>(80)), dy = positive(r.get<float>(84)), dz = qfac * positive(r.get<float>(88));
+  const double R[3][3] = {{a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
+                          {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
+                          {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
+  const double scale[3] = {dx, dy, dz};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) f.qform[i][j] = R[i][j] * scale[j];
+    f.qform[i][3] = r.get<float>(268 + 4 * std::size_t(i));
+    for (int j = 0; j < 4; ++j) f.sform[i][j] = r.get<float>(280 + 16 * std::size_t(i) + 4 * std::size_t(j));
+  }
+  return f;
+}
+
 }  // namespace surftrack::io

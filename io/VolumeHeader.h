@@ -9,6 +9,8 @@
 // what ITK reads before anything is mapped.
 #pragma once
 
+#include <array>
+
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -87,5 +89,14 @@ std::optional<DataLayout> parseNrrdHeader(std::string_view head, std::uint64_t f
 /// and NIfTI-1 headers whose voxels are in a separate .img file, are left to ITK
 /// (decodeReason); a header without the NIfTI magic is an error.
 std::optional<DataLayout> parseNifti1Header(std::string_view head, std::uint64_t fileSize);
+
+/// The two affines of a NIfTI-1 header, voxel index to RAS millimetres, rows of [M | t]
+/// (nifti1.h, methods 2 and 3): the qform (quaternion, pixdim, qfac, offsets) and the sform
+/// (srow_x..z). Only when both codes are > 0: a reader then has to choose (ITK and nibabel may
+/// choose differently), which is worth a word to the user.
+struct NiftiForms {
+  std::array<std::array<double, 4>, 3> qform{}, sform{};
+};
+std::optional<NiftiForms> niftiForms(std::string_view head);
 
 }  // namespace surftrack::io
