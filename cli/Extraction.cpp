@@ -167,6 +167,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   ExtractOptions eo;
   eo.selection = x.byLabel ? Selection::label(x.value) : Selection::threshold(x.value);
   eo.seed = seedRuleOf(o);
+  eo.maxSeedDistance = o.maxSeedDistance;
   eo.pair = o.pair;
   eo.threads = o.threads;
   eo.mapping = o.mapping == MappingMode::Midpoint ? Mapping::Midpoint

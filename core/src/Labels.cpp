@@ -24,6 +24,7 @@
 #include "LabelSeeds.h"
 #include "LoopExtraction.h"
 #include "MeshComponents.h"
+#include "PhysicalRange.h"
 #include "PlaceSurface.h"
 #include "ScanLabels.h"
 #include "SelectionValue.h"
@@ -241,6 +242,8 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   cancelled();
   const ImageGeometry geometry = source.geometry();
   scan.fill(arrays, [&](const Surfel& s) { return geometry.toPhysical(MidpointMapping{}(s)); });
+  for (const LabelSurface& l : out)  // (as placeSurface checks its vertices: PhysicalRange.h)
+    requirePlacedVertices(geometry, l.surface.vertices, [&](std::size_t v) { return MidpointMapping{}(l.surface.surfels[v]); });
   const bool mirrored = geometry.handedness() < 0;  // keep the normals pointing outwards (placeSurface)
 
   // Largest first, so that the last to finish are small.
@@ -341,6 +344,7 @@ std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptio
     throw InvalidInput("threads " + std::to_string(options.threads) + " is negative (0: all cores)");
   if (std::isnan(options.background)) throw InvalidInput("background is NaN");
   const std::unique_ptr<VoxelSource> source = makeViewSource(view);  // checks the view
+  requirePhysicalDomain(view.geometry, view.dims);                   // before any voxel is read
   return visitScalarType(view.type, [&](auto zero) -> std::vector<LabelSurface> {
     using T = decltype(zero);
     if constexpr (std::is_integral_v<T>)
