@@ -181,6 +181,8 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   Surface surface;
   try {
     surface = extract(volume, eo);
+  } catch (const SeedTooFar& e) {
+    throw std::runtime_error(e.what());  // no pass over the volume: the search read only near the seed
   } catch (const InvalidInput& e) {
     explainNoSurface(volume, x, e.what());
   }

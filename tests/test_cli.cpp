@@ -861,6 +861,45 @@ TEST_F(Cli, TheNearestSurfelSeedSearchIsBounded) {
   expectFailure(mesh("out.ply", {"--seed", "599,4,4", "--max-seed-distance", "far"}), 2, "positive number of voxels");
 }
 
+TEST_F(Cli, ASeedFarFromEveryObjectFailsHavingReadOnlyNearIt) {
+  // A 128 MiB memory-mapped raw file (sparse), 256 x 256 x 2048, one box at z < 8; the seed at
+  // z = 2000. The error comes from the voxels within 256 voxels of it — the planes z >= 1736,
+  // a seventh of the file's pages (z is the slowest axis) — not from all of them.
+  const std::string big = path("big.raw");
+  const std::uintmax_t bytes = std::uintmax_t(256) * 256 * 2048;
+  {
+    std::ofstream out(big, std::ios::binary);
+    const std::string row(10, char(200));
+    for (int z = 0; z < 8; ++z)
+      for (int y = 100; y < 110; ++y) {
+        out.seekp(std::streamoff((std::uintmax_t(z) * 256 + y) * 256 + 100));
+        out.write(row.data(), std::streamsize(row.size()));
+      }
+  }
+  fs::resize_file(big, bytes);
+  auto maxResident = [&](const std::vector<std::string>& args, RunResult& r) {
+    struct rusage usage {};
+    const pid_t pid = startTool(args, scratch_);
+    r = finishTool(pid, scratch_, &usage);
+    return std::uintmax_t(usage.ru_maxrss) * 1024;  // (kilobytes on Linux)
+  };
+  RunResult small, far;
+  // The process's own footprint: the same command on a 1 MiB file.
+  std::ofstream(path("small.raw"), std::ios::binary) << std::string(1 << 20, '\0');
+  const std::uintmax_t baseline = maxResident(
+      {"mesh", path("small.raw"), "--raw-dims", "1024,32,32", "--raw-type", "uint8", "--iso", "100", "--seed",
+       "1000,16,16", "-o", path("out.ply")},
+      small);
+  EXPECT_EQ(small.code, 1) << small.err;
+  const std::uintmax_t resident = maxResident(
+      {"mesh", big, "--raw-dims", "256,256,2048", "--raw-type", "uint8", "--iso", "100", "--seed", "128,128,2000",
+       "-o", path("out.ply")},
+      far);
+  EXPECT_EQ(far.code, 1) << far.err;
+  EXPECT_NE(far.err.find("has no boundary surfel within 256 voxels"), std::string::npos) << far.err;
+  EXPECT_LT(resident, baseline + bytes / 3) << "resident " << resident << " bytes, baseline " << baseline;
+}
+
 // --- surftrack info: quantiles against numpy ------------------------------------------------
 
 /// numpy.quantile(values of the raw file, qs) by /usr/bin/python3, one value a line; empty if

@@ -433,7 +433,7 @@ TEST(FrontDoor, TheNearestSurfelSearchStopsAtTheMaxSeedDistance) {
     try {
       extract(counting, o);
       ADD_FAILURE() << "no error for a seed 3992 voxels from the object";
-    } catch (const InvalidInput& e) {
+    } catch (const SeedTooFar& e) {
       const std::string message = e.what();
       EXPECT_NE(message.find("has no boundary surfel within 256 voxels"), std::string::npos) << message;
       EXPECT_NE(message.find("maxSeedDistance"), std::string::npos) << message;
@@ -453,7 +453,7 @@ TEST(FrontDoor, TheNearestSurfelSearchStopsAtTheMaxSeedDistance) {
     EXPECT_EQ(within.surfels, unbounded.surfels);
     EXPECT_EQ(within.triangles, unbounded.triangles);
     o.maxSeedDistance = std::nextafter(*unbounded.seed.distance / 0.5, 0.0);
-    EXPECT_THROW(extract(*view, o), InvalidInput);
+    EXPECT_THROW(extract(*view, o), SeedTooFar);
   }
   // Not a positive number of voxels.
   for (double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {

@@ -116,10 +116,10 @@ Surfel resolveNearestSeed(const SourceImage& binary, const std::array<double, 3>
   }
   if (maxVoxels * minSpacing >= std::sqrt(farthest) * maxSpacing)
     throw InvalidInput(what + " has no boundary surfel near it: the selection is empty");
-  throw InvalidInput(what + " has no boundary surfel within " + numberText(maxVoxels, 10) +
-                     " voxels, the maximum seed distance (ExtractOptions::maxSeedDistance; " +
-                     "--max-seed-distance on the command line, max_seed_distance in Python): " +
-                     "raise it, or give a seed nearer the object");
+  throw SeedTooFar(what + " has no boundary surfel within " + numberText(maxVoxels, 10) +
+                   " voxels, the maximum seed distance (ExtractOptions::maxSeedDistance; " +
+                   "--max-seed-distance on the command line, max_seed_distance in Python): the object " +
+                   "lies farther or the selection is empty; raise the distance, or give a seed nearer the object");
 }
 
 /// The ray rule for a voxel: a 1-voxel walks to the first 1->0 step, a 0-voxel to the first

@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -88,11 +89,12 @@ inline pid_t startTool(const std::vector<std::string>& args, const fs::path& scr
 }
 
 /// Waits for a tool started by startTool: its status as the shell gives it (128 + the signal
-/// that ended it, if one did) and its output.
-inline RunResult finishTool(pid_t pid, const fs::path& scratch) {
+/// that ended it, if one did) and its output; its resource usage through `usage` (wait4).
+inline RunResult finishTool(pid_t pid, const fs::path& scratch, struct rusage* usage = nullptr) {
   int status = 0;
   RunResult r;
-  if (waitpid(pid, &status, 0) == pid)
+  struct rusage ignored;
+  if (wait4(pid, &status, 0, usage ? usage : &ignored) == pid)
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
   r.out = readText(scratch / "stdout.txt");
   r.err = readText(scratch / "stderr.txt");

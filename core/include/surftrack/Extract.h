@@ -159,7 +159,7 @@ struct Surface {
 /// \throw InvalidInput for a selection the source cannot hold (a label of a float volume, a
 ///        label that is not a value of the type, a NaN threshold), a seed outside the domain
 ///        or on no boundary, no boundary surfel within maxSeedDistance of a Voxel or Point
-///        seed, an empty selection (largest / all find no boundary), a geometry (spacing,
+///        seed (SeedTooFar, an InvalidInput), an empty selection (largest / all find no boundary), a geometry (spacing,
 ///        origin) that puts vertices beyond the float range of mesh coordinates.
 /// \throw Cancelled when options.cancel is raised.
 /// \throw InternalError when an engine invariant fails (a bug).
