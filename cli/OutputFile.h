@@ -36,7 +36,8 @@ std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bo
 
 /// Several output files written completely or not at all: each is written under a temporary
 /// name (a LiveTemporary, removed by the tool's handler of SIGINT: cli/Interrupt.h), and
-/// commit() moves them all into place, with SIGINT and SIGTERM held until it is done. In a directory of outputs the temporary names
+/// commit() moves them all into place, with SIGINT and SIGTERM held until it is done. In a
+/// directory of outputs the temporary names
 /// lie in a staging directory next to it, which commit() renames to the directory (which must
 /// then not exist, or be empty); otherwise they lie next to their targets, and commit() moves
 /// the files already there aside, renames the new ones over them and, if a rename fails,

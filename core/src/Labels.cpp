@@ -242,8 +242,10 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   cancelled();
   const ImageGeometry geometry = source.geometry();
   scan.fill(arrays, [&](const Surfel& s) { return geometry.toPhysical(MidpointMapping{}(s)); });
-  for (const LabelSurface& l : out)  // (as placeSurface checks its vertices: PhysicalRange.h)
-    requirePlacedVertices(geometry, l.surface.vertices, [&](std::size_t v) { return MidpointMapping{}(l.surface.surfels[v]); });
+  for (const LabelSurface& l : out) {  // (as placeSurface checks its vertices: PhysicalRange.h)
+    const Surface& s = l.surface;
+    requirePlacedVertices(geometry, s.vertices, [&](std::size_t v) { return MidpointMapping{}(s.surfels[v]); });
+  }
   const bool mirrored = geometry.handedness() < 0;  // keep the normals pointing outwards (placeSurface)
 
   // Largest first, so that the last to finish are small.
