@@ -458,7 +458,7 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
       "--seed x,y,z and --seed-point: the nearest surfel within D voxels\n(of the smallest spacing), "
       "else an error (default: 256)")
       ->check(explained(kNumber & CLI::PositiveNumber, "--max-seed-distance takes a positive number of voxels"))
-      ->group(which);
+      ->group("surface options");
 
   addSurfaceOptions(app, o.surface.pair, o.ascii, o.surface.threads,
                     "threads for the scan of --largest / --all and for --smooth\n"
