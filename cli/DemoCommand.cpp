@@ -24,9 +24,9 @@ namespace {
 namespace fs = std::filesystem;
 
 /// The cortical surface of ch2better.nii.gz (the Colin27 T1 MRI, skull-stripped, uint8,
-/// 0.5 mm voxels). Its histogram ('surftrack info') has the background at 0-1 and, inside the
-/// brain (51-130), a gray-matter peak at 86 and a white-matter peak at 115 with a shallow
-/// valley between them; iso-value 100, about halfway, gives the gray/white-matter interface of
+/// 0.5 mm voxels). Its histogram ('surftrack info --json') has the background at 0 (63 % of the
+/// voxels) and, inside the brain (51-130), a gray-matter peak at 86 and a white-matter peak at
+/// 114 with a shallow valley between them; iso-value 100, about halfway, gives the gray/white-matter interface of
 /// the cortex (the "white" surface). The largest boundary is the cerebral one.
 constexpr double kCortexIso = 100;
 /// The AAL atlas region extracted: label 1, the left precentral gyrus (aal.nii.txt).

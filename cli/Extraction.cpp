@@ -178,6 +178,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   ExtractOptions eo;
   eo.selection = x.byLabel ? Selection::label(x.label) : Selection::threshold(x.value);
   eo.seed = seedRuleOf(o);
+  eo.maxSeedDistance = o.maxSeedDistance;
   eo.pair = o.pair;
   eo.threads = o.threads;
   eo.mapping = o.mapping == MappingMode::Midpoint ? Mapping::Midpoint
@@ -191,6 +192,8 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   Surface surface;
   try {
     surface = extract(volume, eo);
+  } catch (const SeedTooFar& e) {
+    throw std::runtime_error(e.what());  // no pass over the volume: the search read only near the seed
   } catch (const InvalidInput& e) {
     explainNoSurface(volume, x, e.what());
   }

@@ -72,10 +72,8 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   const OutputKind kind = outputKind(o.output);
   if (kind == OutputKind::Pattern) {
     meshFormat(o.output);
-    std::string probe = o.output;  // its directory, when the pattern does not vary it
-    replaceAll(probe, "{label}", "0");
-    replaceAll(probe, "{name}", "x");
-    if (fs::path(o.output).parent_path().string().find('{') == std::string::npos) requireWritable(probe);
+    const std::string dir = fs::path(o.output).parent_path().string();  // when the pattern does not vary it
+    if (dir.find('{') == std::string::npos) requireWritableDirectory(dir.empty() ? "." : dir, o.output);
   }
   if (kind == OutputKind::OnePly) requireWritable(o.output);
   if (!o.table.empty()) {
@@ -91,6 +89,14 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   } else if (!o.noNames) {
     if (const auto sidecar = labelNamesSidecar(o.input.path)) namesFile = *sidecar;
   }
+  // No output may be an input (the volume, the names): the files of a pattern are checked once
+  // their names are known, before any is written.
+  const std::vector<std::string> inputs = {o.input.path, namesFile};
+  auto requireNoInput = [&](const std::string& output) {
+    for (const std::string& input : inputs) requireNotInput(output, input);
+  };
+  if (kind == OutputKind::OnePly) requireNoInput(o.output);
+  if (!o.table.empty()) requireNoInput(o.table);
   if (!namesFile.empty()) names = readLabelNames(namesFile);
   StagedOutputs staged = kind == OutputKind::Directory ? StagedOutputs::inDirectory(o.output) : StagedOutputs();
 
@@ -143,6 +149,7 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
       replaceAll(file, "{name}", fileSafe(r.name));
       if (!files.insert(file).second)
         throw UsageError("two labels give the file name '" + file + "': put {label} in the pattern");
+      requireNoInput(file);
       r.file = file;
     }
     rows.push_back(std::move(r));

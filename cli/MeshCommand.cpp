@@ -17,6 +17,7 @@ int runMesh(const std::vector<std::string>& args) {
   x.format = meshFormat(o.output);  // a usage error, before any work
   x.binary = !o.ascii && (x.format == "ply" || x.format == "stl");
   requireWritable(o.output);        // fail now rather than after the work
+  requireNotInput(o.output, o.input.path);
 
   Progress progress(Progress::wanted(o.out.quiet));
   StageClock clock;

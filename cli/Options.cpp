@@ -476,6 +476,12 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                                ->check(tripleOf({kNumber}, "expected three numbers X,Y,Z"))
                                ->group(which);
   a.seedRules = {seed, seedRay, seedPoint, a.largest, a.all};
+  addValue(
+      app, "--max-seed-distance", "D", [&o](const std::string& s) { o.surface.maxSeedDistance = *toNumber(s); },
+      "--seed x,y,z and --seed-point: the nearest surfel within D voxels\n(of the smallest spacing), "
+      "else an error (default: 256)")
+      ->check(explained(kNumber & CLI::PositiveNumber, "--max-seed-distance takes a positive number of voxels"))
+      ->group("surface options");
 
   addSurfaceOptions(app, o.surface.pair, o.ascii, o.surface.threads,
                     "threads for the scan of --largest / --all and for --smooth\n"

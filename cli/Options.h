@@ -56,6 +56,7 @@ struct SurfaceOptions {
   Voxel seedVoxel;               ///< --seed x,y,z (Voxel), --seed-ray x,y,z (Ray) or the c of --seed x,y,z,DIR
   Direction seedDirection = 0;   ///< the DIR of --seed x,y,z,DIR (SeedMode::Surfel)
   std::array<double, 3> seedPoint{};  ///< --seed-point X,Y,Z (physical coordinates)
+  double maxSeedDistance = 256;  ///< --max-seed-distance D: the nearest-surfel search's bound, in voxels
   AdjacencyPair pair = AdjacencyPair::k26_6;
   MappingMode mapping = MappingMode::Default;
   int threads = 0;               ///< --threads N (0: all cores)

@@ -23,20 +23,33 @@ std::string meshFormat(const std::string& path) {
                    "' (the extension must be .ply, .obj, .off or .stl)");
 }
 
+void requireWritableDirectory(const std::string& directory, const std::string& what) {
+  std::error_code ec;
+  const fs::path dir(directory);
+  if (!fs::exists(dir, ec))
+    throw std::runtime_error("cannot write '" + what + "': directory '" + directory + "' does not exist");
+  if (!fs::is_directory(dir, ec))
+    throw std::runtime_error("cannot write '" + what + "': '" + directory + "' is not a directory");
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw std::runtime_error("cannot write '" + what + "': directory '" + directory + "' is not writable");
+}
+
 void requireWritable(const std::string& path) {
   std::error_code ec;
   const fs::path target(path);
   if (fs::is_directory(target, ec))
     throw std::runtime_error("cannot write '" + path + "': it is a directory");
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::exists(dir, ec))
-    throw std::runtime_error("cannot write '" + path + "': directory '" + dir.string() + "' does not exist");
-  if (!fs::is_directory(dir, ec))
-    throw std::runtime_error("cannot write '" + path + "': '" + dir.string() + "' is not a directory");
-  if (::access(dir.c_str(), W_OK | X_OK) != 0)
-    throw std::runtime_error("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
+  requireWritableDirectory(dir.string(), path);
   if (fs::exists(target, ec) && ::access(target.c_str(), W_OK) != 0 && ::access(dir.c_str(), W_OK) != 0)
     throw std::runtime_error("cannot write '" + path + "': permission denied");
+}
+
+void requireNotInput(const std::string& output, const std::string& input) {
+  std::error_code ec;
+  if (fs::equivalent(output, input, ec) && !ec)
+    throw std::runtime_error("cannot write '" + output + "': it is the input file '" + input +
+                             "' (writing it would replace the input)");
 }
 
 std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bool binary) {
@@ -75,10 +88,11 @@ StagedOutputs StagedOutputs::inDirectory(const std::string& directory) {
   if (fs::is_directory(dir, ec) && !fs::is_empty(dir, ec))
     throw std::runtime_error("cannot write into '" + directory +
                              "': the directory is not empty (a directory of outputs is written whole)");
-  requireWritable((dir.parent_path().empty() ? fs::path(".") : dir.parent_path()).string() + "/probe");
+  requireWritableDirectory((dir.parent_path().empty() ? fs::path(".") : dir.parent_path()).string(), directory);
   StagedOutputs out;
   out.directory_ = dir.string();
   out.staging_ = (dir.parent_path() / hiddenTemporaryName(dir.filename().string())).string();
+  out.live_.emplace_back(out.staging_, LiveTemporary::Kind::Directory);
   if (!fs::create_directory(out.staging_, ec))
     throw std::runtime_error("cannot create '" + out.staging_ + "': " + ec.message());
   return out;
@@ -86,9 +100,10 @@ StagedOutputs StagedOutputs::inDirectory(const std::string& directory) {
 
 StagedOutputs::StagedOutputs(StagedOutputs&& other) noexcept
     : directory_(std::move(other.directory_)), staging_(std::move(other.staging_)),
-      files_(std::move(other.files_)), committed_(other.committed_) {
+      files_(std::move(other.files_)), live_(std::move(other.live_)), committed_(other.committed_) {
   other.staging_.clear();
   other.files_.clear();
+  other.live_.clear();
 }
 
 StagedOutputs::~StagedOutputs() {
@@ -107,11 +122,14 @@ std::string StagedOutputs::temporaryFor(const std::string& target) {
     requireWritable(target);
     temporary = (t.parent_path() / hiddenTemporaryName(t.stem().string(), t.extension().string())).string();
   }
+  live_.emplace_back(temporary);
   files_.emplace_back(temporary, target);
   return temporary;
 }
 
 void StagedOutputs::commit() {
+  // Whole or not at all: a signal is handled after the renames, when no temporary is left.
+  const TerminationSignalsDeferred deferred;
   std::error_code ec;
   if (!staging_.empty()) {
     fs::rename(staging_, directory_, ec);  // replaces an empty directory
@@ -145,6 +163,7 @@ void StagedOutputs::commit() {
     for (const auto& [old, backup] : aside) fs::remove(backup, ignored);
   }
   committed_ = true;
+  live_.clear();
 }
 
 }  // namespace surftrack::cli

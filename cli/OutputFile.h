@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "Extract.h"
+#include "TemporaryFiles.h"
 
 namespace surftrack::cli {
 
@@ -18,12 +19,25 @@ std::string meshFormat(const std::string& path);
 /// is missing or not writable, or `path` is a directory.
 void requireWritable(const std::string& path);
 
+/// Throws std::runtime_error (one line, "cannot write '<what>': ...") unless `directory` exists,
+/// is a directory and this process may create files in it (access W_OK | X_OK: no file is
+/// created to find out, so no name in it is reserved).
+void requireWritableDirectory(const std::string& directory, const std::string& what);
+
+/// Throws std::runtime_error (one line) if `output` is the file `input` — the same file by
+/// std::filesystem::equivalent, so also through a symbolic or hard link or another spelling of
+/// the path: writing the output would replace the input. Nothing is checked when either does
+/// not exist.
+void requireNotInput(const std::string& output, const std::string& input);
+
 /// Writes the surface's triangles (binary PLY / STL unless `binary` is false) with OpenMesh's
 /// writers (converter/MeshIO.h writeTriangles); returns the file size.
 std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bool binary);
 
 /// Several output files written completely or not at all: each is written under a temporary
-/// name, and commit() moves them all into place. In a directory of outputs the temporary names
+/// name (a LiveTemporary, removed by the tool's handler of SIGINT: cli/Interrupt.h), and
+/// commit() moves them all into place, with SIGINT and SIGTERM held until it is done. In a
+/// directory of outputs the temporary names
 /// lie in a staging directory next to it, which commit() renames to the directory (which must
 /// then not exist, or be empty); otherwise they lie next to their targets, and commit() moves
 /// the files already there aside, renames the new ones over them and, if a rename fails,
@@ -48,6 +62,7 @@ class StagedOutputs {
  private:
   std::string directory_, staging_;
   std::vector<std::pair<std::string, std::string>> files_;  ///< (temporary, target)
+  std::vector<LiveTemporary> live_;  ///< the staging directory and the temporaries
   bool committed_ = false;
 };
 

@@ -399,11 +399,11 @@ void printVolumeInfo(std::ostream& out, const std::string& path, const io::Loade
     if (s.nonFinite) v << ", " << s.nonFinite << " non-finite voxels";
     row(out, "values", v.str());
   }
-  {
+  if (!s.quantiles.empty()) {
     std::ostringstream q;
-    q << "1% " << num(s.quantile(0.01)) << ", 25% " << num(s.quantile(0.25)) << ", 50% "
-      << num(s.quantile(0.5)) << ", 75% " << num(s.quantile(0.75)) << ", 99% " << num(s.quantile(0.99))
-      << " (histogram bins of " << num(s.binWidth) << ")";
+    for (std::size_t i = 0; i < s.quantiles.size(); ++i)
+      q << (i ? ", " : "") << num(100 * s.quantiles[i].first) << "% " << num(s.quantiles[i].second);
+    q << " (numpy.quantile's linear definition)";
     row(out, "quantiles", q.str());
   }
   row(out, "otsu", num(s.otsu, 10) + " (the default --iso of 'surftrack mesh')");
@@ -440,6 +440,11 @@ json volumeJson(const std::string& path, const io::LoadedVolume& volume, const V
   j["mean"] = number(s.mean);
   j["non_finite"] = s.nonFinite;
   j["otsu"] = number(s.otsu);
+  if (!s.quantiles.empty()) {
+    json quantiles = json::array();
+    for (auto [q, value] : s.quantiles) quantiles.push_back({{"q", number(q)}, {"value", number(value)}});
+    j["quantiles"] = std::move(quantiles);
+  }
   j["histogram"] = {{"bin_width", number(s.binWidth)}, {"counts", s.histogram}};
   if (!s.labels.empty()) {
     json labels = json::array();

@@ -1,6 +1,7 @@
 #include "VolumeStats.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -128,14 +129,102 @@ VolumeStats statsOf(const VolumeView& view) {
 
 }  // namespace
 
-double VolumeStats::quantile(double q) const {
-  const double target = q * double(voxels);
-  double seen = 0;
-  for (int b = 0; b < int(histogram.size()); ++b) {
-    seen += double(histogram[b]);
-    if (seen >= target) return std::min(max, min + (b + 1) * binWidth);
+namespace {
+
+/// The voxel types' values as unsigned integers of the same width in the same order
+/// (radix selection): signed integers with the sign bit flipped, floats with the sign bit
+/// flipped when positive and every bit flipped when negative.
+template <class T>
+using KeyOf = std::conditional_t<sizeof(T) == 1, std::uint8_t,
+              std::conditional_t<sizeof(T) == 2, std::uint16_t,
+              std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
+
+template <class T>
+KeyOf<T> orderKey(T v) {
+  using K = KeyOf<T>;
+  constexpr K sign = K(K(1) << (8 * sizeof(T) - 1));
+  const K bits = std::bit_cast<K>(v);
+  if constexpr (std::is_floating_point_v<T>) return (bits & sign) ? K(~bits) : K(bits | sign);
+  else if constexpr (std::is_signed_v<T>) return K(bits ^ sign);
+  else return bits;
+}
+
+template <class T>
+T fromOrderKey(KeyOf<T> key) {
+  using K = KeyOf<T>;
+  constexpr K sign = K(K(1) << (8 * sizeof(T) - 1));
+  if constexpr (std::is_floating_point_v<T>) return std::bit_cast<T>((key & sign) ? K(key & ~sign) : K(~key));
+  else if constexpr (std::is_signed_v<T>) return std::bit_cast<T>(K(key ^ sign));
+  else return T(key);
+}
+
+/// The values of the given ranks (0-based, among the finite values in ascending order): a most
+/// significant digit first radix selection on orderKey, 16 bits a pass. Each rank keeps the
+/// digits fixed so far (its prefix) and its rank among the values of that prefix; ranks with
+/// the same prefix share a pass's histogram.
+template <class T>
+std::vector<double> valuesAtRanks(const VolumeView& view, const std::vector<std::uint64_t>& ranks) {
+  using K = KeyOf<T>;
+  constexpr int kBits = 8 * sizeof(T);
+  constexpr int kDigit = kBits < 16 ? kBits : 16;
+  struct Search {
+    std::uint64_t prefix = 0, rank = 0;
+  };
+  std::vector<Search> searches;
+  for (std::uint64_t r : ranks) searches.push_back({0, r});
+  for (int shift = kBits - kDigit; shift >= 0; shift -= kDigit) {
+    std::vector<std::uint64_t> prefixes;  // the distinct prefixes, one histogram each
+    for (const Search& s : searches)
+      if (std::find(prefixes.begin(), prefixes.end(), s.prefix) == prefixes.end()) prefixes.push_back(s.prefix);
+    std::vector<std::vector<std::uint64_t>> histograms(prefixes.size(), std::vector<std::uint64_t>(1u << kDigit, 0));
+    const bool first = shift + kDigit == kBits;  // no digit fixed yet: every value has prefix 0
+    forEachValue<T>(view, [&](T v) {
+      if constexpr (std::is_floating_point_v<T>)
+        if (!std::isfinite(v)) return;
+      const std::uint64_t key = orderKey(v);
+      const std::uint64_t prefix = first ? 0 : key >> (shift + kDigit);
+      const std::size_t digit = std::size_t((key >> shift) & ((std::uint64_t(1) << kDigit) - 1));
+      for (std::size_t p = 0; p < prefixes.size(); ++p)
+        if (prefixes[p] == prefix) ++histograms[p][digit];
+    });
+    for (Search& s : searches) {
+      const auto& h = histograms[std::size_t(std::find(prefixes.begin(), prefixes.end(), s.prefix) - prefixes.begin())];
+      std::size_t digit = 0;
+      while (digit + 1 < h.size() && s.rank >= h[digit]) s.rank -= h[digit++];
+      s.prefix = (s.prefix << kDigit) | digit;
+    }
   }
-  return max;
+  std::vector<double> values;
+  for (const Search& s : searches) values.push_back(double(fromOrderKey<T>(K(s.prefix))) + 0.0);  // (-0 as 0)
+  return values;
+}
+
+/// numpy's linear interpolation (numpy.lib.function_base._lerp): from b backwards for t >= 0.5,
+/// so that t = 1 gives b exactly.
+double lerp(double a, double b, double t) {
+  const double diff = b - a;
+  return t >= 0.5 ? b - diff * (1 - t) : a + diff * t;
+}
+
+}  // namespace
+
+void addQuantiles(const VolumeView& volume, VolumeStats& stats, const std::vector<double>& qs) {
+  stats.quantiles.clear();
+  if (stats.voxels == 0) return;
+  const std::uint64_t last = stats.voxels - 1;
+  std::vector<std::uint64_t> ranks;
+  for (double q : qs) {
+    const double h = double(last) * q;  // numpy: (n - 1) * q
+    const std::uint64_t below = std::min(last, std::uint64_t(std::floor(h)));
+    ranks.push_back(below);
+    ranks.push_back(std::min(last, below + 1));
+  }
+  const std::vector<double> values = visitScalarType(
+      volume.type, [&](auto type) { return valuesAtRanks<decltype(type)>(volume, ranks); });
+  for (std::size_t i = 0; i < qs.size(); ++i) {
+    const double h = double(last) * qs[i];
+    stats.quantiles.emplace_back(qs[i], lerp(values[2 * i], values[2 * i + 1], h - std::floor(h)));
+  }
 }
 
 std::optional<std::array<double, 2>> valueRange(const VolumeView& volume) {

@@ -1,11 +1,12 @@
 // Value statistics of a volume: range, a 256-bin histogram, Otsu's threshold (the default
-// iso-value), the labels of an integer image with few distinct values.
+// iso-value), the labels of an integer image with few distinct values, and exact quantiles.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <optional>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "LabelValue.h"
@@ -25,12 +26,19 @@ struct VolumeStats {
   /// and its voxel count.
   std::vector<std::pair<LabelValue, std::size_t>> labels;
   bool integral = false;
-
-  /// The value below which a fraction q of the voxels lie (from the histogram).
-  double quantile(double q) const;
+  /// (q, quantile) pairs, when addQuantiles computed them.
+  std::vector<std::pair<double, double>> quantiles;
 };
 
 VolumeStats computeStats(const VolumeView& volume);
+
+/// Sets stats.quantiles to the q-quantile of the finite values of `volume` for each q in
+/// [0, 1], exactly as numpy.quantile's default ("linear") method defines it: with the n values
+/// sorted, a[h] at h = (n - 1) q, interpolated linearly between a[floor h] and a[floor h + 1].
+/// The ranks are found by a radix selection over the values' bits, 16 bits a pass (one pass
+/// for 8- and 16-bit voxels, two for 32-bit, four for 64-bit), in constant memory.
+/// \pre `stats` is computeStats(volume).
+void addQuantiles(const VolumeView& volume, VolumeStats& stats, const std::vector<double>& qs);
 
 /// The smallest and largest finite values (one pass), or nothing if no value is finite.
 std::optional<std::array<double, 2>> valueRange(const VolumeView& volume);

@@ -10,10 +10,12 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include "Commands.h"
+#include "Interrupt.h"
 #include "Options.h"
 
 int main(int argc, char** argv) {
   using namespace surftrack::cli;
+  removeTemporariesOnTermination();  // Ctrl-C leaves no temporary file (Interrupt.h)
   // OpenMesh reports its own IO failures on stderr, over several lines; ours say it in one.
   omerr().disable();
   omlog().disable();

@@ -18,6 +18,8 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/IO/exporter/BaseExporter.hh>
 
+#include "TemporaryFiles.h"
+
 namespace surftrack {
 namespace {
 
@@ -252,6 +254,7 @@ std::string meshExtension(const std::string& path) {
 void writeFileAtomically(const std::string& path, const std::function<bool(const std::string&)>& write) {
   const fs::path target(path);
   const fs::path temporary = temporaryPathFor(target, lowerExtension(target));
+  const LiveTemporary live(temporary.string());  // removed by a handler of SIGINT (TemporaryFiles.h)
   std::error_code ignored;
   bool written = false;
   try {

@@ -48,7 +48,8 @@ void writeLabelledTriangles(const std::vector<LabelledMesh>& meshes, const std::
 /// Calls write(temporary) with a fresh file name next to `path` (same directory and extension),
 /// then renames that file over `path`: a reader sees the old file or the whole new one, never a
 /// partial one. If `write` throws or returns false the temporary file is removed and
-/// std::runtime_error names `path`.
+/// std::runtime_error names `path`. The temporary is a LiveTemporary while it exists
+/// (TemporaryFiles.h): a handler of SIGINT removes it.
 void writeFileAtomically(const std::string& path, const std::function<bool(const std::string& temporary)>& write);
 
 }  // namespace surftrack

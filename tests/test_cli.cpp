@@ -5,9 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <functional>
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 
 #include "Phantoms.h"
@@ -736,6 +740,235 @@ TEST_F(CliErrors, UsageErrors) {
   expectFailure({"frobnicate"}, 2, "unknown command 'frobnicate'");
 }
 
+// --- outputs that are inputs, the output directory check, geometry, seed distance -------------
+
+/// Writes the voxels of `image` as a headerless raw file (x fastest, then y, then z).
+template <class T>
+void writeRaw(const std::string& file, const DenseImage<T>& image) {
+  std::ofstream out(file, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(image.data().data()), std::streamsize(image.data().size() * sizeof(T)));
+}
+
+TEST_F(Cli, AnOutputThatIsTheInputIsRefused) {
+  const DenseImage<std::uint8_t> image = boxVolume<std::uint8_t>(Dims{16, 16, 16}, Voxel{4, 4, 4}, Voxel{10, 10, 10}, 9, 0);
+  const std::string in = path("rawin.ply");  // a raw volume under a mesh's name
+  writeRaw(in, image);
+  const std::string bytes = readText(in);
+  auto raw = [](std::vector<std::string> args) {
+    for (const char* a : {"--raw-dims", "16,16,16", "--raw-type", "uint8"}) args.push_back(a);
+    return args;
+  };
+  // The same name, another spelling of it, a symbolic link and a hard link to it.
+  fs::create_symlink(in, path("symlink.ply"));
+  fs::create_hard_link(in, path("hardlink.ply"));
+  for (const std::string& out : {in, (work_ / "." / "rawin.ply").string(), path("symlink.ply"), path("hardlink.ply")}) {
+    expectFailure(raw({"mesh", in, "--label", "9", "-o", out}), 1, "is the input file");
+    expectFailure(raw({"labels", in, "-o", out}), 1, "is the input file");
+  }
+  // labels: the table, a file of a pattern, the label names.
+  fs::copy_file(in, path("vol.csv"));
+  expectFailure(raw({"labels", path("vol.csv"), "-o", path("out/"), "--table", path("vol.csv")}), 1,
+                "is the input file");
+  fs::copy_file(in, path("9.ply"));
+  expectFailure(raw({"labels", path("9.ply"), "-o", path("{label}.ply")}), 1, "is the input file");
+  std::ofstream(path("names.csv")) << "9 box\n";
+  expectFailure(raw({"labels", in, "-o", path("out/"), "--label-names", path("names.csv"), "--table", path("names.csv")}),
+                1, "is the input file");
+  for (const char* file : {"rawin.ply", "vol.csv", "9.ply"}) EXPECT_EQ(readText(path(file)), bytes) << file;
+  EXPECT_EQ(readText(path("names.csv")), "9 box\n");
+  // Another file of the same name is an ordinary output.
+  fs::create_directories(work_ / "other");
+  const RunResult r = run(raw({"mesh", in, "--label", "9", "-o", path("other/rawin.ply"), "--json"}));
+  expectGoodMesh(r, path("other/rawin.ply"), countBoundarySurfels(image, [](std::uint8_t v) { return v == 9; }),
+                 std::nullopt);
+  EXPECT_EQ(readText(in), bytes);
+}
+
+TEST_F(Cli, AnOutputDirectoryIsCheckedWithoutAFileNameInIt) {
+  DenseImage<std::uint16_t> image = boxVolume<std::uint16_t>(Dims{12, 12, 12}, Voxel{1, 1, 1}, Voxel{4, 4, 4}, 1, 0);
+  for (int z = 6; z < 10; ++z)
+    for (int y = 6; y < 10; ++y)
+      for (int x = 6; x < 10; ++x) image.at(x, y, z) = 2;
+  const std::string in = path("labels.nrrd");
+  io::writeVolume(io::AnyVolume(image), in);
+  // Anything named "probe" next to the output directory, or named as a pattern's file of label
+  // 0, is no obstacle.
+  fs::create_directories(work_ / "data" / "probe");
+  const RunResult r = run({"labels", in, "-o", path("data/abc/"), "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(listDirectory(path("data/abc")), (std::vector<std::string>{"label_1.ply", "label_2.ply", "labels.csv"}));
+  EXPECT_EQ(listDirectory(path("data")), (std::vector<std::string>{"abc", "probe"}));
+  fs::create_directories(work_ / "pattern" / "mesh-0.ply");
+  const RunResult p = run({"labels", in, "-o", path("pattern/mesh-{label}.ply"), "--quiet"});
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_EQ(listDirectory(path("pattern")), (std::vector<std::string>{"mesh-0.ply", "mesh-1.ply", "mesh-2.ply"}));
+  // The directory is still checked: missing, or not writable.
+  expectFailure({"labels", in, "-o", path("missing/abc/")}, 1, "does not exist");
+  expectFailure({"labels", in, "-o", path("missing/mesh-{label}.ply")}, 1, "does not exist");
+  if (!isRoot()) {
+    fs::create_directories(work_ / "ro");
+    fs::permissions(work_ / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    expectFailure({"labels", in, "-o", path("ro/abc/")}, 1, "not writable");
+    expectFailure({"labels", in, "-o", path("ro/mesh-{label}.ply")}, 1, "not writable");
+  }
+}
+
+TEST_F(CliErrors, AGeometryBeyondTheFloatRangeIsRefused) {
+  // 1e300: the vertices would be inf; 1e38: finite doubles, but beyond the floats of the file.
+  for (const char* spacing : {"1e300,1e300,1e300", "1,1e38,1"}) {
+    for (const char* rule : {"--largest", "--all"})
+      expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", rule, "--spacing", spacing}, 1,
+                    "put vertices beyond the float range");
+    expectFailure({"mesh", input_, "-o", path("out.ply"), "--iso", "100", "--seed", "4,4,4", "--spacing", spacing}, 1,
+                  "put vertices beyond the float range");
+    expectFailure({"labels", input_, "-o", path("out/"), "--spacing", spacing}, 1, "put vertices beyond the float range");
+  }
+  expectFailure({"mesh", input_, "-o", path("out.ply"), "--label", "200", "--origin", "0,-1e39,0"}, 1,
+                "put vertices beyond the float range");
+  // Large but within the range: written, every vertex finite.
+  const RunResult r = run({"mesh", input_, "-o", path("big.ply"), "--iso", "100", "--spacing", "1e36,1e36,1e36", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const MeshCheck c = checkMeshFile(path("big.ply"));
+  ASSERT_TRUE(c.read);
+  for (int a = 0; a < 3; ++a) EXPECT_TRUE(std::isfinite(c.min[a]) && std::isfinite(c.max[a]));
+  EXPECT_GT(c.max[0], 1e36);
+}
+
+TEST_F(Cli, TheNearestSurfelSeedSearchIsBounded) {
+  // A box at x in [0, 3] of a 600 voxels long raw file: the seed (599,4,4) is 595.5 voxels from
+  // its face at x = 3.5.
+  const DenseImage<std::uint8_t> image = boxVolume<std::uint8_t>(Dims{600, 8, 8}, Voxel{0, 2, 2}, Voxel{3, 5, 5}, 200, 0);
+  const std::string in = path("long.raw");
+  writeRaw(in, image);
+  auto mesh = [&](const std::string& out, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"mesh", in, "--raw-dims", "600,8,8", "--raw-type", "uint8", "--iso", "100",
+                                     "-o", path(out)};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  };
+  expectFailure(mesh("out.ply", {"--seed", "599,4,4"}), 1, "has no boundary surfel within 256 voxels");
+  expectFailure(mesh("out.ply", {"--seed", "599,4,4"}), 1, "--max-seed-distance");
+  expectFailure(mesh("out.ply", {"--seed-point", "599,4,4", "--max-seed-distance", "595"}), 1,
+                "has no boundary surfel within 595 voxels");
+  // Within the distance: the box, as --largest gives it.
+  const RunResult r = run(mesh("seeded.ply", {"--seed", "599,4,4", "--max-seed-distance", "596", "--json"}));
+  expectGoodMesh(r, path("seeded.ply"), surfelsAbove(image, 100), std::nullopt);
+  EXPECT_EQ(jsonNumber(r.out, "distance"), 595.5);
+  const RunResult largest = run(mesh("largest.ply", {"--largest", "--quiet"}));
+  ASSERT_EQ(largest.code, 0) << largest.err;
+  EXPECT_EQ(readText(path("seeded.ply")), readText(path("largest.ply")));
+  expectFailure(mesh("out.ply", {"--seed", "599,4,4", "--max-seed-distance", "0"}), 2, "positive number of voxels");
+  expectFailure(mesh("out.ply", {"--seed", "599,4,4", "--max-seed-distance", "far"}), 2, "positive number of voxels");
+}
+
+TEST_F(Cli, ASeedFarFromEveryObjectFailsHavingReadOnlyNearIt) {
+  // A 128 MiB memory-mapped raw file (sparse), 256 x 256 x 2048, one box at z < 8; the seed at
+  // z = 2000. The error comes from the voxels within 256 voxels of it — the planes z >= 1736,
+  // a seventh of the file's pages (z is the slowest axis) — not from all of them.
+  const std::string big = path("big.raw");
+  const std::uintmax_t bytes = std::uintmax_t(256) * 256 * 2048;
+  {
+    std::ofstream out(big, std::ios::binary);
+    const std::string row(10, char(200));
+    for (int z = 0; z < 8; ++z)
+      for (int y = 100; y < 110; ++y) {
+        out.seekp(std::streamoff((std::uintmax_t(z) * 256 + y) * 256 + 100));
+        out.write(row.data(), std::streamsize(row.size()));
+      }
+  }
+  fs::resize_file(big, bytes);
+  auto maxResident = [&](const std::vector<std::string>& args, RunResult& r) {
+    struct rusage usage {};
+    const pid_t pid = startTool(args, scratch_);
+    r = finishTool(pid, scratch_, &usage);
+    return std::uintmax_t(usage.ru_maxrss) * 1024;  // (kilobytes on Linux)
+  };
+  RunResult small, far;
+  // The process's own footprint: the same command on a 1 MiB file.
+  std::ofstream(path("small.raw"), std::ios::binary) << std::string(1 << 20, '\0');
+  const std::uintmax_t baseline = maxResident(
+      {"mesh", path("small.raw"), "--raw-dims", "1024,32,32", "--raw-type", "uint8", "--iso", "100", "--seed",
+       "1000,16,16", "-o", path("out.ply")},
+      small);
+  EXPECT_EQ(small.code, 1) << small.err;
+  const std::uintmax_t resident = maxResident(
+      {"mesh", big, "--raw-dims", "256,256,2048", "--raw-type", "uint8", "--iso", "100", "--seed", "128,128,2000",
+       "-o", path("out.ply")},
+      far);
+  EXPECT_EQ(far.code, 1) << far.err;
+  EXPECT_NE(far.err.find("has no boundary surfel within 256 voxels"), std::string::npos) << far.err;
+  EXPECT_LT(resident, baseline + bytes / 3) << "resident " << resident << " bytes, baseline " << baseline;
+}
+
+// --- surftrack info: quantiles against numpy ------------------------------------------------
+
+/// numpy.quantile(values of the raw file, qs) by /usr/bin/python3, one value a line; empty if
+/// python3 or numpy is missing.
+std::vector<double> numpyQuantiles(const fs::path& raw, const std::string& dtype, const std::vector<double>& qs,
+                                   const fs::path& scratch) {
+  std::ostringstream script;
+  script << "import numpy as np\n"
+         << "a = np.fromfile('" << raw.string() << "', dtype='" << dtype << "')\n"
+         << "for q in [";
+  for (double q : qs) script << q << ",";
+  script << "]: print(repr(float(np.quantile(a, q))))\n";
+  const fs::path file = scratch / "quantiles.py";
+  std::ofstream(file) << script.str();
+  const std::string cmd = "/usr/bin/python3 " + shellQuote(file.string()) + " 2>/dev/null";
+  std::vector<double> values;
+  if (FILE* pipe = ::popen(cmd.c_str(), "r")) {
+    char line[128];
+    while (std::fgets(line, sizeof line, pipe)) values.push_back(std::strtod(line, nullptr));
+    ::pclose(pipe);
+  }
+  return values;
+}
+
+TEST_F(Cli, InfoQuantilesAreNumpys) {
+  if (std::system("/usr/bin/python3 -c 'import numpy' 2>/dev/null") != 0)
+    GTEST_SKIP() << "/usr/bin/python3 with numpy is needed (apt-get install python3-numpy)";
+  const std::vector<double> qs = {0.01, 0.25, 0.5, 0.75, 0.99};
+  std::mt19937_64 rng(20260118);
+  // Each case: a raw file of random values of one type; numpy's dtype name.
+  auto check = [&](const std::string& type, const std::string& dtype, auto image, double relative) {
+    SCOPED_TRACE(type);
+    const std::string file = path(type + ".raw");
+    writeRaw(file, image);
+    const std::vector<double> expected = numpyQuantiles(file, dtype, qs, scratch_);
+    ASSERT_EQ(expected.size(), qs.size()) << "numpy failed";
+    const Dims& d = image.dims();
+    const RunResult r = run({"info", file, "--raw-dims",
+                             std::to_string(d.nx) + "," + std::to_string(d.ny) + "," + std::to_string(d.nz),
+                             "--raw-type", type, "--json"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const double range = jsonNumber(r.out, "max") - jsonNumber(r.out, "min");
+    std::smatch m;
+    std::string rest = r.out.substr(r.out.find("\"quantiles\""));
+    for (std::size_t i = 0; i < qs.size(); ++i) {
+      ASSERT_TRUE(std::regex_search(rest, m, std::regex("\"value\": (-?[0-9.eE+-]+)"))) << r.out;
+      EXPECT_NEAR(std::stod(m[1]), expected[i], relative * range) << "q " << qs[i];
+      rest = m.suffix();
+    }
+  };
+  // The values 0..9, a tenth each: numpy gives 0, 2, 4.5, 7 and 9 (not 1, 3, 5, 8, 9).
+  DenseImage<std::uint8_t> tenths(Dims{10, 10, 10}, 0);
+  for (std::size_t i = 0; i < tenths.data().size(); ++i) tenths.data()[i] = std::uint8_t(i % 10);
+  check("uint8", "u1", tenths, 1e-15);
+  auto random = [&](auto zero, Dims d, auto draw) {
+    DenseImage<decltype(zero)> image(d, zero);
+    for (auto& v : image.data()) v = decltype(zero)(draw());
+    return image;
+  };
+  std::uniform_int_distribution<int> i16(-30000, 30000);
+  check("int16", "<i2", random(std::int16_t{}, Dims{13, 11, 7}, [&] { return i16(rng); }), 1e-15);
+  check("uint32", "<u4", random(std::uint32_t{}, Dims{17, 9, 8}, [&] { return rng() >> 32; }), 1e-15);
+  std::uniform_int_distribution<std::int64_t> i64(-(std::int64_t(1) << 50), std::int64_t(1) << 50);
+  check("int64", "<i8", random(std::int64_t{}, Dims{9, 9, 9}, [&] { return i64(rng); }), 1e-15);
+  std::normal_distribution<double> normal(0, 100);
+  check("float", "<f4", random(float{}, Dims{15, 14, 6}, [&] { return normal(rng); }), 1e-6);
+  check("double", "<f8", random(double{}, Dims{8, 8, 11}, [&] { return normal(rng) * 1e-3; }), 1e-15);
+}
+
 // --- the real MRI volumes of mricron-data ----------------------------------------------------
 
 const fs::path kMricron = "/usr/share/mricron/templates";
@@ -917,6 +1150,87 @@ TEST_F(Cli, LabelsBadInputIsOneLineAndLeavesNothing) {
   expectFailure({"labels", in, "-o", path("out/"), "--labels", "1,x"}, 2, "not an integer label");
   expectFailure({"labels", in, "-o", path("out/"), "--seed", "0,0,0"}, 1, "background");
   expectFailure({"labels", in, "-o", path("nowhere/{label}.ply")}, 1, "does not exist");
+}
+
+// --- interrupted runs --------------------------------------------------------------------------
+
+/// Polls `dir` (every 0.2 ms, up to a minute) until `seen(name, path)` holds for one of its
+/// entries, then sends `signal` to the tool `pid`. False if the tool ended before that.
+template <class Seen>
+bool interruptWhen(pid_t pid, const fs::path& dir, int signal, Seen seen) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+      if (seen(it->path().filename().string(), it->path())) {
+        ::kill(pid, signal);
+        return true;
+      }
+    int status = 0;
+    if (::waitpid(pid, &status, WNOHANG) == pid) return false;  // (reaped: finishTool is not called)
+    ::usleep(200);
+  }
+  ::kill(pid, SIGKILL);
+  return false;
+}
+
+/// 8000 labels: a 60^3 volume of 3x3x3 blocks, each its own label; writing their meshes takes
+/// long enough to be interrupted.
+DenseImage<std::uint16_t> manyLabels() {
+  DenseImage<std::uint16_t> image(Dims{60, 60, 60}, 0);
+  for (int z = 0; z < 60; ++z)
+    for (int y = 0; y < 60; ++y)
+      for (int x = 0; x < 60; ++x) image.at(x, y, z) = std::uint16_t(1 + x / 3 + 20 * (y / 3) + 400 * (z / 3));
+  return image;
+}
+
+TEST_F(Cli, AnInterruptedLabelsRunLeavesNoTemporary) {
+  const std::string in = path("many.nrrd");
+  io::writeVolume(io::AnyVolume(manyLabels()), in);
+  auto isStaging = [](const std::string& name) { return name.rfind(".out.tmp-", 0) == 0; };
+  // SIGINT while the meshes are written into the staging directory; SIGTERM as soon as it
+  // exists (reading or extracting); SIGINT while a pattern's temporaries are written.
+  struct Case {
+    int signal;
+    std::string output;
+    std::function<bool(const std::string&, const fs::path&)> seen;
+  };
+  const std::vector<Case> cases = {
+      {SIGINT, path("out/"), [&](const std::string& name, const fs::path& p) {
+         std::error_code ec;
+         return isStaging(name) && !fs::is_empty(p, ec) && !ec;
+       }},
+      {SIGTERM, path("out/"), [&](const std::string& name, const fs::path&) { return isStaging(name); }},
+      {SIGINT, path("mesh-{label}.ply"), [](const std::string& name, const fs::path&) { return name.rfind(".mesh-", 0) == 0; }},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.output + ", signal " + std::to_string(c.signal));
+    const pid_t pid = startTool({"labels", in, "-o", c.output, "--quiet"}, scratch_);
+    ASSERT_GT(pid, 0);
+    ASSERT_TRUE(interruptWhen(pid, work_, c.signal, c.seen)) << "the run ended before it could be interrupted";
+    const RunResult r = finishTool(pid, scratch_);
+    EXPECT_EQ(r.code, 128 + c.signal) << r.err;
+    EXPECT_EQ(r.err, c.signal == SIGINT ? "surftrack: interrupted\n" : "surftrack: terminated\n");
+    EXPECT_EQ(listDirectory(work_), std::vector<std::string>{"many.nrrd"}) << "no output, no temporary";
+  }
+}
+
+TEST_F(Cli, AnInterruptedMeshWriteLeavesNoTemporary) {
+  // Noise: about 800 000 surfels, written as a text PLY of some 50 MB.
+  DenseImage<std::uint8_t> noise(Dims{80, 80, 80}, 0);
+  std::mt19937 rng(7);
+  for (auto& v : noise.data()) v = std::uint8_t(rng() & 1);
+  const std::string in = path("noise.nrrd");
+  io::writeVolume(io::AnyVolume(noise), in);
+  fs::create_directories(work_ / "d");
+  const pid_t pid = startTool({"mesh", in, "-o", path("d/c.ply"), "--iso", "0.5", "--all", "--ascii", "--quiet"}, scratch_);
+  ASSERT_GT(pid, 0);
+  ASSERT_TRUE(interruptWhen(pid, work_ / "d", SIGINT,
+                            [](const std::string& name, const fs::path&) { return name.rfind(".c.tmp-", 0) == 0; }))
+      << "the run ended before its write could be interrupted";
+  const RunResult r = finishTool(pid, scratch_);
+  EXPECT_EQ(r.code, 130) << r.err;
+  EXPECT_EQ(listDirectory(work_ / "d"), std::vector<std::string>{}) << "no output, no temporary";
 }
 
 }  // namespace

@@ -4,11 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <surftrack/Extract.h>
+#include <surftrack/Labels.h>
+#include <surftrack/Refine.h>
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <new>
 #include <random>
@@ -388,10 +392,126 @@ TEST(FrontDoor, NearestSurfelSeedIsTheBruteForceNearest) {
           }
     const std::optional<NearestSurfel> found = nearestBoundarySurfel(binary, p, g);
     ASSERT_EQ(found.has_value(), best.has_value()) << "trial " << trial;
+    // Bounded (the seed rules' maxSeedDistance): the nearest if it lies within the bound (at
+    // it included), nothing otherwise — whatever bricks the bound lets the search skip.
+    const double limit = double(rng() % 300) / 10;
+    const std::optional<NearestSurfel> bounded = nearestBoundarySurfel(binary, p, g, limit);
+    ASSERT_EQ(bounded.has_value(), best && bestDistance <= limit) << "trial " << trial << ", limit " << limit;
+    if (best && found) {
+      const std::optional<NearestSurfel> atBest = nearestBoundarySurfel(binary, p, g, found->distance);
+      ASSERT_TRUE(atBest) << "trial " << trial;
+      EXPECT_EQ(atBest->surfel, *best) << "trial " << trial;
+    }
     if (!best) continue;
     EXPECT_EQ(found->surfel, *best) << "trial " << trial;
     EXPECT_DOUBLE_EQ(found->distance, bestDistance) << "trial " << trial;
+    if (bounded) {
+      EXPECT_EQ(bounded->surfel, *best) << "trial " << trial;
+    }
   }
+}
+
+// A seed far from every object: the nearest-surfel search stops at maxSeedDistance with an
+// error that names it, having read only the bricks within that distance; at the distance of the
+// nearest surfel (found with no bound) it gives that surfel and the same surface.
+TEST(FrontDoor, TheNearestSurfelSearchStopsAtTheMaxSeedDistance) {
+  const Dims d{4096, 64, 64};
+  std::vector<std::uint8_t> v(d.count(), 0);
+  for (int z = 16; z < 48; ++z)
+    for (int y = 16; y < 48; ++y)
+      for (int x = 0; x < 8; ++x) v[(std::size_t(z) * d.ny + y) * d.nx + x] = 200;
+  ImageGeometry g;
+  g.spacing = {0.5, 1, 2};  // the distance is in voxels of the smallest spacing, 0.5
+  const auto view = makeViewSource(VolumeView::of(v.data(), d, g));
+  ExtractOptions o;
+  o.selection = Selection::threshold(100);
+  for (const SeedRule& rule : {SeedRule::fromVoxel({4000, 32, 32}), SeedRule::point(g.toPhysical({4000, 32, 32}))}) {
+    o.seed = rule;
+    o.maxSeedDistance = 256;  // the default
+    const CountingSource counting(*view);
+    const auto started = std::chrono::steady_clock::now();
+    try {
+      extract(counting, o);
+      ADD_FAILURE() << "no error for a seed 3992 voxels from the object";
+    } catch (const SeedTooFar& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("has no boundary surfel within 256 voxels"), std::string::npos) << message;
+      EXPECT_NE(message.find("maxSeedDistance"), std::string::npos) << message;
+      EXPECT_NE(message.find("--max-seed-distance"), std::string::npos) << message;
+    }
+    // The bricks within 256 voxels of x = 4000 (and their aprons), not the 16.8 M voxels.
+    EXPECT_LT(counting.read, d.count() / 4) << counting.read << " voxels read";
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(), 5.0);
+
+    o.maxSeedDistance = std::numeric_limits<double>::infinity();
+    const Surface unbounded = extract(*view, o);
+    ASSERT_TRUE(unbounded.seed.distance);
+    EXPECT_NEAR(*unbounded.seed.distance, (4000 - 7.5) * 0.5, 1e-9);  // to the face at x = 7.5
+    o.maxSeedDistance = *unbounded.seed.distance / 0.5;
+    const Surface within = extract(*view, o);
+    EXPECT_EQ(within.seed.surfel, unbounded.seed.surfel);
+    EXPECT_EQ(within.surfels, unbounded.surfels);
+    EXPECT_EQ(within.triangles, unbounded.triangles);
+    o.maxSeedDistance = std::nextafter(*unbounded.seed.distance / 0.5, 0.0);
+    EXPECT_THROW(extract(*view, o), SeedTooFar);
+  }
+  // Not a positive number of voxels.
+  for (double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    o.maxSeedDistance = bad;
+    EXPECT_THROW(extract(*view, o), InvalidInput) << bad;
+  }
+}
+
+// A spacing or origin that puts vertices beyond the float range (mesh files store floats) —
+// or the double range, where they would be inf — is InvalidInput before any voxel is read, for
+// extract (every seed rule), extractLabels and smooth, not a mesh of infinite vertices.
+TEST(FrontDoor, AGeometryBeyondTheFloatRangeIsInvalidInput) {
+  const Dims d{20, 20, 20};
+  const std::vector<std::uint8_t> v = noisyBall<std::uint8_t>(d, 6, 0);
+  auto message = [](auto&& f) -> std::string {
+    try {
+      f();
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "no InvalidInput";
+  };
+  ImageGeometry huge, beyondFloat, farOrigin, justInside;
+  huge.spacing = {1e300, 1e300, 1e300};                  // inf in double
+  beyondFloat.spacing = {1, 1e38, 1};                    // 2e39: finite in double, not in float
+  farOrigin.origin = {0, 0, -1e39};                      // finite in double, not in float
+  justInside.spacing = {1e37, 1e37, 1e37};               // 20e37 < 3.4e38
+  for (const ImageGeometry& g : {huge, beyondFloat, farOrigin}) {
+    const VolumeView view = VolumeView::of(v.data(), d, g);
+    ExtractOptions o;
+    o.selection = Selection::threshold(60.5);
+    for (const SeedRule& rule : {SeedRule::all(), SeedRule::largest(), SeedRule::fromVoxel({10, 10, 10}),
+                                 SeedRule::ray({10, 10, 10})}) {
+      o.seed = rule;
+      const auto source = makeViewSource(view);
+      const CountingSource counting(*source);
+      const std::string m = message([&] { extract(counting, o); });
+      EXPECT_NE(m.find("put vertices beyond the float range"), std::string::npos) << m;
+      EXPECT_EQ(counting.read, 0u);
+    }
+    LabelOptions lo;
+    const std::string m = message([&] { extractLabels(view, lo); });
+    EXPECT_NE(m.find("put vertices beyond the float range"), std::string::npos) << m;
+  }
+  // At the edge of the range, the vertices are finite as floats.
+  ExtractOptions o;
+  o.selection = Selection::threshold(60.5);
+  o.seed = SeedRule::fromVoxel({10, 10, 10});
+  Surface s = extract(VolumeView::of(v.data(), d, justInside), o);
+  ASSERT_FALSE(s.vertices.empty());
+  for (const auto& p : s.vertices)
+    for (double x : p) EXPECT_TRUE(std::isfinite(float(x))) << x;
+  // smooth() on a surface whose geometry was changed: refused, the vertices untouched.
+  s.geometry = huge;
+  const std::vector<std::array<double, 3>> before = s.vertices;
+  const std::string m = message([&] { smooth(s, SmoothOptions{}); });
+  EXPECT_NE(m.find("put vertices beyond the float range"), std::string::npos) << m;
+  EXPECT_EQ(s.vertices, before);
 }
 
 TEST(FrontDoor, TheSpeckWarningFiresOnASpeckAndNotOnTheBall) {

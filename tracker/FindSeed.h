@@ -51,7 +51,9 @@ struct NearestSurfel {
 /// to the smallest Surfel::key, so the answer does not depend on the search order. The search
 /// reads 8x8x8 bricks (binariseBrick) in rings of growing Chebyshev distance around the point's
 /// brick and stops as soon as no unread brick can hold a nearer midpoint, or beyond
-/// `maxDistance` (physical): its cost grows with the distance to the surface, not the volume.
+/// `maxDistance` (physical); a brick whose every midpoint is farther than the best found so
+/// far or than maxDistance is not read: its cost grows with the distance to the surface, not
+/// the volume, and is at most about the ball of radius maxDistance.
 /// std::nullopt if there is no boundary surfel within maxDistance.
 template <class BinaryImage>
 std::optional<NearestSurfel> nearestBoundarySurfel(
@@ -98,14 +100,29 @@ std::optional<NearestSurfel> nearestBoundarySurfel(
   double outside = 0;
   for (int a = 0; a < 3; ++a)
     outside = std::max({outside, 8.0 * centre[a] - point[a], point[a] - (8.0 * centre[a] + 8.0)});
+  // The same bound for one brick: the index-space distance from the point to the box of its
+  // midpoints, [8b - 0.5, 8b + 7.5] on each axis, times minSpacing — shrunk by a relative 1e-9,
+  // so that rounding in the physical distances never skips a brick holding the nearest.
+  auto brickLowerBound = [&](int bx, int by, int bz) {
+    const int b[3] = {bx, by, bz};
+    double squared = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double gap = std::max({0.0, 8.0 * b[a] - 0.5 - point[a], point[a] - (8.0 * b[a] + 7.5)});
+      squared += gap * gap;
+    }
+    return std::sqrt(squared) * minSpacing * (1 - 1e-9);
+  };
   for (int k = 0; k <= maxRing; ++k) {
     const double lowerBound = std::max(0.0, (k - 1) * 8.0 - outside - 0.5) * minSpacing;
     if (lowerBound > maxDistance || (best && best->distance < lowerBound)) break;
     for (int bz = std::max(0, centre[2] - k); bz <= std::min(last[2], centre[2] + k); ++bz)
       for (int by = std::max(0, centre[1] - k); by <= std::min(last[1], centre[1] + k); ++by)
-        for (int bx = std::max(0, centre[0] - k); bx <= std::min(last[0], centre[0] + k); ++bx)
-          if (std::max({std::abs(bx - centre[0]), std::abs(by - centre[1]), std::abs(bz - centre[2])}) == k)
-            scanBrick(bx, by, bz);
+        for (int bx = std::max(0, centre[0] - k); bx <= std::min(last[0], centre[0] + k); ++bx) {
+          if (std::max({std::abs(bx - centre[0]), std::abs(by - centre[1]), std::abs(bz - centre[2])}) != k) continue;
+          const double brickBound = brickLowerBound(bx, by, bz);
+          if (brickBound > maxDistance || (best && best->distance < brickBound)) continue;
+          scanBrick(bx, by, bz);
+        }
   }
   return best;
 }

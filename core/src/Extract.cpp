@@ -12,6 +12,7 @@
 #include "FindSeed.h"
 #include "LoopExtraction.h"
 #include "ScanIsoSurface.h"
+#include "PhysicalRange.h"
 #include "PlaceSurface.h"
 #include "SelectionValue.h"
 #include "SourceImage.h"
@@ -90,14 +91,34 @@ class Stages {
                      " with a 0-voxel next to it: the image has no boundary surfel");
 }
 
-/// The nearest-surfel rule (FindSeed.h) for a point in index coordinates; `what` names the seed
-/// in messages.
+/// The nearest-surfel rule (FindSeed.h) for a point in index coordinates, up to maxVoxels
+/// voxels of the smallest spacing (ExtractOptions::maxSeedDistance); `what` names the seed in
+/// messages.
 Surfel resolveNearestSeed(const SourceImage& binary, const std::array<double, 3>& index,
-                          const ImageGeometry& geometry, const std::string& what, SeedReport& seed) {
-  const std::optional<NearestSurfel> nearest = nearestBoundarySurfel(binary, index, geometry);
-  if (!nearest) throw InvalidInput(what + " has no boundary surfel near it: the selection is empty");
-  seed.distance = nearest->distance;
-  return nearest->surfel;
+                          const ImageGeometry& geometry, double maxVoxels, const std::string& what,
+                          SeedReport& seed) {
+  const auto& sp = geometry.spacing;
+  const double minSpacing = std::min({std::abs(sp[0]), std::abs(sp[1]), std::abs(sp[2])});
+  const double maxSpacing = std::max({std::abs(sp[0]), std::abs(sp[1]), std::abs(sp[2])});
+  const std::optional<NearestSurfel> nearest =
+      nearestBoundarySurfel(binary, index, geometry, maxVoxels * minSpacing);
+  if (nearest) {
+    seed.distance = nearest->distance;
+    return nearest->surfel;
+  }
+  // Did the bound cover every midpoint of the domain ([-0.5, n - 0.5] on each axis)?
+  const Dims& dims = binary.dims();
+  double farthest = 0;  // index-space distance to the farthest corner of that box
+  for (int a = 0; a < 3; ++a) {
+    const double gap = std::max(std::abs(index[a] + 0.5), std::abs(dims[a] - 0.5 - index[a]));
+    farthest += gap * gap;
+  }
+  if (maxVoxels * minSpacing >= std::sqrt(farthest) * maxSpacing)
+    throw InvalidInput(what + " has no boundary surfel near it: the selection is empty");
+  throw SeedTooFar(what + " has no boundary surfel within " + numberText(maxVoxels, 10) +
+                   " voxels, the maximum seed distance (ExtractOptions::maxSeedDistance; " +
+                   "--max-seed-distance on the command line, max_seed_distance in Python): the object " +
+                   "lies farther or the selection is empty; raise the distance, or give a seed nearer the object");
 }
 
 /// The ray rule for a voxel: a 1-voxel walks to the first 1->0 step, a 0-voxel to the first
@@ -196,6 +217,7 @@ void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mappin
     tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
     arena.execute([&] { tbb::parallel_for(std::size_t(0), runs, place); });
   }
+  requirePlacedVertices(geometry, out.vertices, [&](std::size_t v) { return MidpointMapping{}(mesh.surfels[v]); });
   out.surfels = std::move(mesh.surfels);
   out.triangles = std::move(mesh.triangles);
   if (geometry.handedness() < 0)  // a mirrored frame: keep the normals pointing outwards
@@ -226,6 +248,9 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
   if (o.threads < 0) throw InvalidInput("threads " + std::to_string(o.threads) + " is negative (0: all cores)");
   if (!(o.epsilon > 0 && o.epsilon < 0.5))
     throw InvalidInput("epsilon " + numberText(o.epsilon, 10) + " is outside ]0, 0.5[");
+  if (!(o.maxSeedDistance > 0))
+    throw InvalidInput("maxSeedDistance " + numberText(o.maxSeedDistance, 10) + " is not a positive number of voxels");
+  requirePhysicalDomain(source.geometry(), source.dims());  // before any voxel is read
 
   const bool scanning = o.seed.kind == Kind::All;
   Stages stages(o, scanning ? 3 : 5, out);  // (the last, "figures", is empty without figures)
@@ -266,7 +291,8 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
         out.seed.voxelInside = binary(v);
         std::ostringstream what;
         what << "seed voxel " << v;
-        seed = resolveNearestSeed(binary, {double(v.x), double(v.y), double(v.z)}, geometry, what.str(), out.seed);
+        seed = resolveNearestSeed(binary, {double(v.x), double(v.y), double(v.z)}, geometry, o.maxSeedDistance,
+                                  what.str(), out.seed);
         break;
       }
       case Kind::Point: {
@@ -288,7 +314,7 @@ Surface extract(const VoxelSource& source, const ExtractOptions& o) {
                 << domainText(binary.dims());
             throw InvalidInput(msg.str());
           }
-        seed = resolveNearestSeed(binary, index, geometry, what, out.seed);
+        seed = resolveNearestSeed(binary, index, geometry, o.maxSeedDistance, what, out.seed);
         break;
       }
       case Kind::Surfel: seed = resolveSurfelSeed(binary, o.seed.surfel); break;

@@ -24,6 +24,7 @@
 #include "LabelSeeds.h"
 #include "LoopExtraction.h"
 #include "MeshComponents.h"
+#include "PhysicalRange.h"
 #include "PlaceSurface.h"
 #include "ScanLabels.h"
 #include "SelectionValue.h"
@@ -230,6 +231,10 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   cancelled();
   const ImageGeometry geometry = source.geometry();
   scan.fill(arrays, [&](const Surfel& s) { return geometry.toPhysical(MidpointMapping{}(s)); });
+  for (const LabelSurface& l : out) {  // (as placeSurface checks its vertices: PhysicalRange.h)
+    const Surface& s = l.surface;
+    requirePlacedVertices(geometry, s.vertices, [&](std::size_t v) { return MidpointMapping{}(s.surfels[v]); });
+  }
   const bool mirrored = geometry.handedness() < 0;  // keep the normals pointing outwards (placeSurface)
 
   // Largest first, so that the last to finish are small.
@@ -328,6 +333,7 @@ std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptio
   if (options.threads < 0)
     throw InvalidInput("threads " + std::to_string(options.threads) + " is negative (0: all cores)");
   const std::unique_ptr<VoxelSource> source = makeViewSource(view);  // checks the view
+  requirePhysicalDomain(view.geometry, view.dims);                   // before any voxel is read
   return visitScalarType(view.type, [&](auto zero) -> std::vector<LabelSurface> {
     using T = decltype(zero);
     if constexpr (std::is_integral_v<T>)

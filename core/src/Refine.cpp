@@ -3,9 +3,12 @@
 // figures recomputed.
 #include "Refine.h"
 
+#include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 #include "ConstrainedSmoothing.h"
+#include "PhysicalRange.h"
 #include "PlaceSurface.h"
 #include "SurfaceMesh.h"
 #include "TopologySafeDecimation.h"
@@ -70,7 +73,29 @@ auto translatingErrors(F&& f) {
 
 }  // namespace
 
+namespace {
+
+/// Throws InvalidInput if surface.geometry puts a point of a surfel's segment [c, d] — where
+/// smoothing moves the vertex — beyond the float range (PhysicalRange.h): the box of the
+/// surfels' voxels, checked at its corners, before any vertex moves.
+void requireSegmentsInRange(const Surface& surface) {
+  if (surface.surfels.empty()) return;
+  std::array<double, 3> lo, hi;
+  lo.fill(std::numeric_limits<double>::infinity());
+  hi.fill(-std::numeric_limits<double>::infinity());
+  for (const Surfel& s : surface.surfels)
+    for (const Voxel v : {s.inside(), s.outside()})
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], double(v[a]));
+        hi[a] = std::max(hi[a], double(v[a]));
+      }
+  requirePhysicalBox(surface.geometry, lo, hi);
+}
+
+}  // namespace
+
 SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
+  requireSegmentsInRange(surface);
   refine::SmoothingParameters p;
   p.iterations = o.iterations;
   p.lambda = o.lambda;

@@ -182,7 +182,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
                       std::array<double, 3> spacing, std::array<double, 3> origin,
                       std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
                       py::object progress, int smoothIterations, std::optional<double> maxError,
-                      std::optional<double> reduction) {
+                      std::optional<double> reduction, double maxSeedDistance) {
   const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
   ExtractOptions o;
   o.selection = selectionKind == "label" ? Selection::label(labelOf(value, "label"))
@@ -192,6 +192,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
   o.epsilon = epsilon;
   o.threads = threads;
   o.figures = figures;
+  o.maxSeedDistance = maxSeedDistance;
   auto engineVoxel = [&](int first) {
     Voxel v;
     for (int e = 0; e < 3; ++e) v[e] = int(seed[first + order[e]]);

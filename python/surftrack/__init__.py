@@ -165,14 +165,16 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
             epsilon: float = 1e-3, threads: int = 0, figures: bool = True,
             progress: Optional[Callable[[str, int, int, int], None]] = None,
             smooth: int = 0, max_error: Optional[float] = None,
-            reduce: Optional[float] = None) -> Surface:
+            reduce: Optional[float] = None, max_seed_distance: float = 256.0) -> Surface:
     """The surface of one boundary (mode="seed"), of the largest, or of all boundaries.
 
     The selected voxels are ``volume > level`` or ``volume == label``. ``seed`` is a voxel index
     ``(i, j, k)`` or a surfel ``((i, j, k), (i2, j2, k2))``; ``seed_point`` is a physical point.
     A voxel or a point resolves to the boundary surfel nearest it (``seed_rule="nearest"``);
     ``seed_rule="ray"`` walks from the voxel along +i, -i, +j, -j, +k, -k to the first boundary
-    crossed instead. ``mapping`` places each
+    crossed instead; the nearest surfel is searched for up to ``max_seed_distance`` voxels (of
+    the smallest spacing; default 256, ``float('inf')`` for no bound), and a seed farther from
+    every boundary is a ValueError rather than a read of the whole volume. ``mapping`` places each
     vertex on its surfel's segment: "linear" (iso-value interpolation, the default for a
     level), "midpoint" (the default for a label). ``progress(stage, index, stages, surfels)``
     is called at each stage and while tracking. ``threads`` (0: all cores) runs the scan of
@@ -196,6 +198,8 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
         raise ValueError(f"smooth takes a number of iterations >= 0, not {smooth!r}")
     if mode not in ("seed", "largest", "all"):
         raise ValueError(f"unknown mode '{mode}': expected 'seed', 'largest' or 'all'")
+    if not float(max_seed_distance) > 0:
+        raise ValueError(f"max_seed_distance takes a positive number of voxels, not {max_seed_distance!r}")
     if adjacency not in _ADJACENCIES:
         raise ValueError(f"unsupported adjacency pair '{adjacency}': expected one of "
                          + ", ".join(_ADJACENCIES))
@@ -245,7 +249,8 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
                                        direction.tolist(), int(threads), bool(figures),
                                        progress, int(smooth),
                                        None if max_error is None else float(max_error),
-                                       None if reduce is None else float(reduce))
+                                       None if reduce is None else float(reduce),
+                                       float(max_seed_distance))
     except ValueError as error:
         note = _range_note(array, value) if kind == "threshold" else ""
         raise ValueError(f"{error}{note}") from None

@@ -108,6 +108,31 @@ def test_progress_and_write(tmp_path):
     assert not (tmp_path / "ball.xyz").exists()
 
 
+def test_max_seed_distance_and_a_geometry_beyond_the_float_range():
+    # A box at k in [0, 3] of a 600 voxels long volume: the seed (4, 4, 599) is 595.5 voxels
+    # from its face at k = 3.5.
+    volume = np.zeros((8, 8, 600), np.uint8)
+    volume[2:6, 2:6, :4] = 200
+    with pytest.raises(ValueError, match="within 256 voxels.*max_seed_distance"):
+        surftrack.extract(volume, level=100, seed=(4, 4, 599))
+    with pytest.raises(ValueError, match="within 595 voxels"):
+        surftrack.extract(volume, level=100, seed=(4, 4, 599), max_seed_distance=595)
+    near = surftrack.extract(volume, level=100, seed=(4, 4, 599), max_seed_distance=596)
+    assert near.seed_distance == 595.5
+    assert canonical(near) == canonical(surftrack.extract(volume, level=100, mode="largest"))
+    unbounded = surftrack.extract(volume, level=100, seed=(4, 4, 599), max_seed_distance=float("inf"))
+    assert canonical(unbounded) == canonical(near)
+    for bad in (0, -1, float("nan")):
+        with pytest.raises(ValueError, match="max_seed_distance"):
+            surftrack.extract(volume, level=100, seed=(4, 4, 599), max_seed_distance=bad)
+    # A spacing that puts the vertices beyond the float range (inf in double, or only in float).
+    for spacing in ((1e300, 1e300, 1e300), (1, 1e38, 1)):
+        with pytest.raises(ValueError, match="beyond the float range"):
+            surftrack.extract(volume, level=100, mode="largest", spacing=spacing)
+    with pytest.raises(ValueError, match="beyond the float range"):
+        surftrack.label_surfaces(volume // 200, spacing=(1e300, 1, 1))
+
+
 @pytest.mark.parametrize("volume,kwargs,error,message", [
     (np.zeros((4, 4)), {}, ValueError, "3-D"),
     (np.zeros((0, 4, 4)), {}, ValueError, "empty"),

@@ -2,6 +2,9 @@
 // make small volumes, read meshes back with OpenMesh, pick fields out of its JSON.
 #pragma once
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -63,6 +66,38 @@ inline RunResult runTool(const std::vector<std::string>& args, const fs::path& s
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
   r.out = readText(out);
   r.err = readText(err);
+  return r;
+}
+
+/// Starts `surftrack ARGS...` without waiting (posix_spawn, no shell: the pid is the tool's own,
+/// for kill()), its stdout and stderr going to files of `scratch`; finishTool waits for it.
+inline pid_t startTool(const std::vector<std::string>& args, const fs::path& scratch) {
+  std::vector<std::string> all = {SURFTRACK_EXE};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, (scratch / "stdout.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 2, (scratch / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, SURFTRACK_EXE, &actions, nullptr, argv.data(), environ) != 0) pid = -1;
+  posix_spawn_file_actions_destroy(&actions);
+  return pid;
+}
+
+/// Waits for a tool started by startTool: its status as the shell gives it (128 + the signal
+/// that ended it, if one did) and its output; its resource usage through `usage` (wait4).
+inline RunResult finishTool(pid_t pid, const fs::path& scratch, struct rusage* usage = nullptr) {
+  int status = 0;
+  RunResult r;
+  struct rusage ignored;
+  if (wait4(pid, &status, 0, usage ? usage : &ignored) == pid)
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  r.out = readText(scratch / "stdout.txt");
+  r.err = readText(scratch / "stderr.txt");
   return r;
 }
 

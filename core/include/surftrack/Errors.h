@@ -12,6 +12,14 @@ class InvalidInput : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// A seed voxel or point with no boundary surfel within ExtractOptions::maxSeedDistance: the
+/// search stopped there, having read only the voxels within that distance (whether the
+/// selection is empty is not known: finding out would read the whole image).
+class SeedTooFar : public InvalidInput {
+ public:
+  using InvalidInput::InvalidInput;
+};
+
 /// A broken invariant inside the engine: a bug, to be reported.
 class InternalError : public std::logic_error {
  public:

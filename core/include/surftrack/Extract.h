@@ -77,6 +77,12 @@ struct ExtractOptions {
   Mapping mapping = Mapping::Default;
   /// The linear mapping keeps t in [epsilon, 1 - epsilon], so that vertices never reach a voxel.
   double epsilon = 1e-3;
+  /// The seed rules Voxel and Point take the nearest boundary surfel within this distance, in
+  /// voxels of the smallest spacing (a surfel's midpoint at most maxSeedDistance * min(spacing)
+  /// away in physical distance), and fail beyond it rather than read the whole image for a
+  /// seed far from any object: the search reads at most about the ball of this radius. Any
+  /// positive number; infinity for no bound.
+  double maxSeedDistance = 256;
   /// Called at each stage and now and then while tracking; runs on the calling thread.
   std::function<void(const ProgressEvent&)> progress;
   /// If set and raised, the extraction stops at the next check and throws Cancelled.
@@ -152,7 +158,9 @@ struct Surface {
 /// Extracts the surface the options ask for from `source`.
 /// \throw InvalidInput for a selection the source cannot hold (a label of a float volume, a
 ///        label that is not a value of the type, a NaN threshold), a seed outside the domain
-///        or on no boundary, an empty selection (largest / all find no boundary).
+///        or on no boundary, no boundary surfel within maxSeedDistance of a Voxel or Point
+///        seed (SeedTooFar, an InvalidInput), an empty selection (largest / all find no boundary), a geometry (spacing,
+///        origin) that puts vertices beyond the float range of mesh coordinates.
 /// \throw Cancelled when options.cancel is raised.
 /// \throw InternalError when an engine invariant fails (a bug).
 Surface extract(const VoxelSource& source, const ExtractOptions& options);
