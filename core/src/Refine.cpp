@@ -4,6 +4,7 @@
 #include "Refine.h"
 
 #include <stdexcept>
+#include <string>
 
 #include "ConstrainedSmoothing.h"
 #include "PlaceSurface.h"
@@ -71,12 +72,16 @@ auto translatingErrors(F&& f) {
 }  // namespace
 
 SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
+  if (o.iterations > kMaxSmoothIterations)
+    throw InvalidInput("smoothing iterations " + std::to_string(o.iterations) + " is above the limit of " +
+                       std::to_string(kMaxSmoothIterations));
   refine::SmoothingParameters p;
   p.iterations = o.iterations;
   p.lambda = o.lambda;
   p.mu = o.mu;
   p.epsilon = o.epsilon;
   p.threads = o.threads;
+  p.cancel = o.cancel;
   SmoothReport report;
   report.volumeBefore = volumeOf(surface);
   // Smoothing moves points only: it works on the surface's arrays, with no half-edge mesh.
@@ -101,6 +106,7 @@ DecimateReport decimate(Surface& surface, const DecimateOptions& o) {
   p.maxError = o.maxError;
   p.targetReduction = o.reduction;
   p.maxNormalDeviation = o.maxNormalDeviation;
+  p.cancel = o.cancel;
   DecimateReport report;
   report.volumeBefore = volumeOf(surface);
   SurfaceMesh mesh = meshOf(surface);
