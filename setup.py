@@ -1,6 +1,8 @@
 """Builds the extension module of the Python package with the project's CMake build (only the
-front door and the module: no CLI, no tests), for the interpreter that runs pip."""
+front door and the module: no CLI, no tests), for the interpreter that runs pip. The package's
+version is CMake's project VERSION, the one the module and the CLI are built with."""
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -33,4 +35,13 @@ class CMakeBuild(build_ext):
         shutil.copy2(built, target)
 
 
-setup(ext_modules=[CMakeExtension("surftrack._surftrack")], cmdclass={"build_ext": CMakeBuild})
+def project_version():
+    """VERSION of CMakeLists.txt's project(): surftrack.__version__ and `surftrack --version`."""
+    match = re.search(r"project\(surftrack\s+VERSION\s+([0-9][0-9.]*)", (ROOT / "CMakeLists.txt").read_text())
+    if not match:
+        raise RuntimeError("CMakeLists.txt has no project(surftrack VERSION ...)")
+    return match.group(1)
+
+
+setup(version=project_version(), ext_modules=[CMakeExtension("surftrack._surftrack")],
+      cmdclass={"build_ext": CMakeBuild})

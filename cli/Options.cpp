@@ -16,6 +16,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "Refine.h"  // kMaxSmoothIterations
+
 namespace surftrack::cli {
 
 namespace {
@@ -502,8 +504,9 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
       ->option_text("[N]")
       ->expected(0, 1)
       ->default_str("20")
-      ->check(explained(CLI::Range(1, 100000), [](const std::string& s) {
-        return "--smooth takes a number of iterations from 1 to 100000, got '" + s + "'";
+      ->check(explained(CLI::Range(1, kMaxSmoothIterations), [](const std::string& s) {
+        return "--smooth takes a number of iterations from 1 to " + std::to_string(kMaxSmoothIterations) +
+               ", got '" + s + "'";
       }))
       ->group(refine);
   addValue(

@@ -1,15 +1,20 @@
 #include "MeshIO.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cctype>
 #include <cstdint>
 #include <cstdio>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <random>
 #include <stdexcept>
 #include <system_error>
@@ -18,6 +23,7 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/IO/exporter/BaseExporter.hh>
 
+#include "Cancellation.h"
 #include "TemporaryFiles.h"
 
 namespace surftrack {
@@ -40,8 +46,13 @@ fs::path temporaryPathFor(const fs::path& path, const std::string& ext) {
   return path.parent_path() / ("." + name);
 }
 
+/// Items (vertices or triangles) written between two checks of a cancel flag.
+constexpr std::size_t kCancelCheck = std::size_t(1) << 16;
+
 /// A triangle list seen as OpenMesh's writers see a mesh: what ExporterT gives for a
-/// SurfaceMesh without normals, colours, texture coordinates or status (double points).
+/// SurfaceMesh without normals, colours, texture coordinates or status (double points). The
+/// writers ask it for every vertex and triangle in turn: every kCancelCheck of those asks, it
+/// checks `cancel` (a raised flag throws Cancelled out of the writer, whose stream closes).
 class TriangleListExporter final : public OpenMesh::IO::BaseExporter {
  public:
   using VH = OpenMesh::VertexHandle;
@@ -51,14 +62,16 @@ class TriangleListExporter final : public OpenMesh::IO::BaseExporter {
   using Status = OpenMesh::Attributes::StatusInfo;
 
   TriangleListExporter(const std::vector<std::array<double, 3>>& v,
-                       const std::vector<std::array<std::uint32_t, 3>>& t)
-      : v_(v), t_(t) {}
+                       const std::vector<std::array<std::uint32_t, 3>>& t, const std::atomic<bool>* cancel)
+      : v_(v), t_(t), cancel_(cancel) {}
 
   OpenMesh::Vec3f point(VH h) const override {
+    tick();
     const auto& p = v_[std::size_t(h.idx())];
     return {float(p[0]), float(p[1]), float(p[2])};
   }
   OpenMesh::Vec3d pointd(VH h) const override {
+    tick();
     const auto& p = v_[std::size_t(h.idx())];
     return {p[0], p[1], p[2]};
   }
@@ -77,6 +90,7 @@ class TriangleListExporter final : public OpenMesh::IO::BaseExporter {
   Status status(VH) const override { return {}; }
 
   unsigned int get_vhandles(FH f, std::vector<VH>& out) const override {
+    tick();
     const auto& t = t_[std::size_t(f.idx())];
     out.assign({VH(int(t[0])), VH(int(t[1])), VH(int(t[2]))});
     return 3;
@@ -120,9 +134,15 @@ class TriangleListExporter final : public OpenMesh::IO::BaseExporter {
   const OpenMesh::BaseKernel* kernel() override { return &noProperties_; }
 
  private:
+  void tick() const {
+    if (asks_++ % kCancelCheck == 0) throwIfCancelled(cancel_, "writing");  // the first ask too
+  }
+
   OpenMesh::BaseKernel noProperties_;
   const std::vector<std::array<double, 3>>& v_;
   const std::vector<std::array<std::uint32_t, 3>>& t_;
+  const std::atomic<bool>* cancel_;
+  mutable std::size_t asks_ = 0;
 };
 
 /// Binary PLY, the most common output, byte for byte as OpenMesh's PLY writer writes it for a
@@ -131,8 +151,10 @@ class TriangleListExporter final : public OpenMesh::IO::BaseExporter {
 /// (docs/performance.md), a large part of a seeded extraction. Several meshes go one after the
 /// other (their triangles' indices shifted); `labelled` adds the label to every vertex and face
 /// as writeLabelledTriangles states (one int, or two 32-bit words). Binary, or text for
-/// writeLabelledTriangles. False if a write fails.
-bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binary, const std::string& path) {
+/// writeLabelledTriangles. False if a write fails (errno says why). `cancel` is checked before
+/// each buffer.
+bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binary, const std::string& path,
+              const std::atomic<bool>* cancel = nullptr) {
   static_assert(std::endian::native == std::endian::little, "binary_little_endian is written as is");
   std::size_t vertexCount = 0, faceCount = 0;
   bool narrow = true, negative = false;  // every label fits int32; some label is negative
@@ -141,7 +163,9 @@ bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binar
     narrow = narrow && m.label.fits<std::int32_t>();
     negative = negative || m.label.negative();
   }
-  std::FILE* file = std::fopen(path.c_str(), "wb");
+  // Closed on every way out, Cancelled included.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> owned(std::fopen(path.c_str(), "wb"), &std::fclose);
+  std::FILE* const file = owned.get();
   if (!file) return false;
   const std::string label = !labelled ? ""
                             : narrow  ? "property int label\n"
@@ -185,6 +209,7 @@ bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binar
     const auto& vertices = *m.vertices;
     const Columns L = columns(m.label);
     for (std::size_t begin = 0; ok && begin < vertices.size(); begin += kChunk) {
+      throwIfCancelled(cancel, "writing");
       const std::size_t n = std::min(kChunk, vertices.size() - begin);
       unsigned char* out = buffer.data();
       text.clear();
@@ -209,6 +234,7 @@ bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binar
     const auto& triangles = *m.triangles;
     const Columns L = columns(m.label);
     for (std::size_t begin = 0; ok && begin < triangles.size(); begin += kChunk) {
+      throwIfCancelled(cancel, "writing");
       const std::size_t n = std::min(kChunk, triangles.size() - begin);
       unsigned char* out = buffer.data();
       text.clear();
@@ -231,12 +257,14 @@ bool writePly(const std::vector<LabelledMesh>& meshes, bool labelled, bool binar
     }
     offset += m.vertices->size();
   }
-  return std::fclose(file) == 0 && ok;
+  if (!ok) return false;  // (errno from the failed write, before fclose may change it)
+  return std::fclose(owned.release()) == 0;
 }
 
 bool writeBinaryPly(const std::vector<std::array<double, 3>>& vertices,
-                    const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path) {
-  return writePly({LabelledMesh{&vertices, &triangles, 0}}, false, true, path);
+                    const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path,
+                    const std::atomic<bool>* cancel) {
+  return writePly({LabelledMesh{&vertices, &triangles, 0}}, false, true, path, cancel);
 }
 
 /// The extension of `path` if it is one writeMesh knows, else std::invalid_argument.
@@ -249,14 +277,42 @@ std::string meshExtension(const std::string& path) {
   return ext;
 }
 
+/// Why `path` cannot be written, from the errno of creating a file next to it: for the
+/// directory's usual failures the words of the CLI (cli/OutputFile.cpp), else the system's.
+FileWriteError cannotCreate(const std::string& path, int error) {
+  const fs::path target(path);
+  const std::string dir = target.has_parent_path() ? target.parent_path().string() : std::string(".");
+  std::error_code ignored;
+  std::string why;
+  if (error == ENOENT && !fs::exists(fs::path(dir), ignored)) why = "directory '" + dir + "' does not exist";
+  else if (error == ENOTDIR) why = "'" + dir + "' is not a directory";
+  else if (error == EACCES || error == EPERM) why = "directory '" + dir + "' is not writable (permission denied)";
+  else why = "cannot create a file in directory '" + dir + "': " + std::generic_category().message(error);
+  return FileWriteError(error, "cannot write '" + path + "': " + why);
+}
+
+/// The exception for a path that is a directory: raised before anything is written.
+void requireNotDirectory(const std::string& path) {
+  std::error_code ignored;
+  if (fs::is_directory(fs::path(path), ignored))
+    throw FileWriteError(EISDIR, "cannot write '" + path + "': it is a directory");
+}
+
 }  // namespace
 
 void writeFileAtomically(const std::string& path, const std::function<bool(const std::string&)>& write) {
+  requireNotDirectory(path);
   const fs::path target(path);
   const fs::path temporary = temporaryPathFor(target, lowerExtension(target));
   const LiveTemporary live(temporary.string());  // removed by a handler of SIGINT (TemporaryFiles.h)
+  // The temporary file is created here, empty, so that a directory that cannot take it is told
+  // with the system's reason: the writers below only say whether they succeeded.
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) throw cannotCreate(path, errno);
+  ::close(fd);
   std::error_code ignored;
   bool written = false;
+  errno = 0;
   try {
     written = write(temporary.string());
   } catch (...) {
@@ -264,31 +320,34 @@ void writeFileAtomically(const std::string& path, const std::function<bool(const
     throw;
   }
   if (!written) {
+    const int error = errno != 0 ? errno : EIO;  // a writer that failed without a system error: EIO
     fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write '" + path + "'");
+    throw FileWriteError(error, "cannot write '" + path + "': " + std::generic_category().message(error));
   }
   std::error_code error;
   fs::rename(temporary, target, error);
   if (error) {
     fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write '" + path + "': " + error.message());
+    throw FileWriteError(error.value(), "cannot write '" + path + "': " + error.message());
   }
 }
 
 void writeTriangles(const std::vector<std::array<double, 3>>& vertices,
                     const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& path,
-                    bool binary) {
+                    bool binary, const std::atomic<bool>* cancel) {
+  requireNotDirectory(path);  // before the extension: "out/" is a directory, not a format
   const std::string ext = meshExtension(path);
   OpenMesh::IO::Options options = OpenMesh::IO::Options::Default;
   if (binary && (ext == ".ply" || ext == ".stl")) options += OpenMesh::IO::Options::Binary;
-  TriangleListExporter exporter(vertices, triangles);
+  TriangleListExporter exporter(vertices, triangles, cancel);
   writeFileAtomically(path, [&](const std::string& temporary) {
-    return ext == ".ply" && binary ? writeBinaryPly(vertices, triangles, temporary)
+    return ext == ".ply" && binary ? writeBinaryPly(vertices, triangles, temporary, cancel)
                                    : OpenMesh::IO::IOManager().write(temporary, exporter, options, 12);
   });
 }
 
 void writeLabelledTriangles(const std::vector<LabelledMesh>& meshes, const std::string& path, bool binary) {
+  requireNotDirectory(path);
   if (meshExtension(path) != ".ply")
     throw std::invalid_argument("cannot write '" + path + "': labelled meshes are written as .ply");
   std::size_t vertices = 0;
@@ -299,6 +358,7 @@ void writeLabelledTriangles(const std::vector<LabelledMesh>& meshes, const std::
 }
 
 void writeMesh(const SurfaceMesh& mesh, const std::string& path, bool binary) {
+  requireNotDirectory(path);
   const std::string ext = meshExtension(path);
   OpenMesh::IO::Options options = OpenMesh::IO::Options::Default;
   if (binary && (ext == ".ply" || ext == ".stl")) options += OpenMesh::IO::Options::Binary;

@@ -9,6 +9,7 @@
 // collapse changes the faces around its from-vertex, and then goes in again.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 
 #include <OpenMesh/Tools/Decimater/BaseDecimaterT.hh>
@@ -26,9 +27,15 @@ class CheckedDecimaterT : public OpenMesh::Decimater::BaseDecimaterT<MeshT> {
   /// triangles remain or no collapse is legal. A candidate enters the heap with
   /// `priority(ci)` (the priority module alone, cheap; ILLEGAL_COLLAPSE keeps it out) and is
   /// asked of OpenMesh's is_collapse_ok and every module when it comes out. Returns the number of collapses.
+  /// `cancel`, if set, is checked every kCancelCheck candidates: raised, Cancelled
+  /// (lib/Cancellation.h) is thrown, the mesh left partly decimated.
   /// \pre initialize() succeeded; the mesh has vertex, halfedge, edge and face status.
   template <class Priority>
-  std::size_t decimateToFaces(std::size_t faces, Priority&& priority);
+  std::size_t decimateToFaces(std::size_t faces, Priority&& priority, const std::atomic<bool>* cancel = nullptr);
+
+  /// Candidates evaluated or taken out of the heap between two checks of the cancel flag: a
+  /// few milliseconds of work.
+  static constexpr std::size_t kCancelCheck = 4096;
 
  private:
   MeshT& mesh_;

@@ -6,11 +6,14 @@
 #include <functional>
 #include <vector>
 
+#include "Cancellation.h"
+
 namespace surftrack::refine {
 
 template <class MeshT>
 template <class Priority>
-std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priority&& priority) {
+std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priority&& priority,
+                                                      const std::atomic<bool>* cancel) {
   struct Candidate {
     float priority;
     int halfedge;
@@ -44,7 +47,15 @@ std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priorit
     else push({p, h.idx(), v});
   };
   heap.reserve(mesh_.n_halfedges());
-  for (auto h : mesh_.halfedges()) evaluate(h);
+  std::size_t steps = 0;  // candidates evaluated or taken out, for the cancel checks
+  auto checkCancel = [&] {
+    if (++steps % kCancelCheck == 0) throwIfCancelled(cancel, "decimation");
+  };
+  throwIfCancelled(cancel, "decimation");
+  for (auto h : mesh_.halfedges()) {
+    evaluate(h);
+    checkCancel();
+  }
   std::make_heap(heap.begin(), heap.end(), std::greater<Candidate>());
   initial = false;
 
@@ -54,6 +65,7 @@ std::size_t CheckedDecimaterT<MeshT>::decimateToFaces(std::size_t faces, Priorit
   // swept out at once.
   std::size_t liveHalfedges = mesh_.n_halfedges();
   while (nf > faces && !heap.empty()) {
+    checkCancel();
     if (heap.size() > 2 * liveHalfedges + 1024) {
       heap.erase(std::remove_if(heap.begin(), heap.end(),
                                 [&](const Candidate& c) {

@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include "BoundaryMapping.h"
+#include "Cancellation.h"
 #include "CompressedLists.h"
 #include "CubeFoldCheck.h"
 #include "DigitalCube.h"
@@ -68,6 +69,7 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   // The one-rings below read each vertex's neighbours off its corners, which takes a closed,
   // oriented 2-manifold (section 8: every continuous analog is one).
   requireClosedOrientedManifold(nv, triangle);
+  throwIfCancelled(p.cancel, "smoothing");
   SmoothingReport report;
   // Passes over the vertices in parallel (threads 0: all cores) but for a small mesh, where a
   // pass costs less than waking the threads.
@@ -338,6 +340,9 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     }
   };
   auto pass = [&](double factor, bool newNormals) {
+    // A pass costs about a tenth of a second per million vertices: checked before each one, a
+    // raised flag stops the smoothing at once, whatever the iteration count.
+    throwIfCancelled(p.cancel, "smoothing");
     for (std::uint32_t v : checkedVertices) previous[v] = t[v];
     arena.execute(
         [&] { forBlocks(nv, parallel, [&](std::size_t b, std::size_t e) { move(factor, newNormals, b, e); }); });

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -24,6 +25,9 @@ struct SmoothingParameters {
   double epsilon = 1e-3;  ///< t stays in [epsilon, 1 - epsilon], epsilon in ]0, 0.5[
   int halvings = 4;       ///< step-back halvings of a vertex's move before it stays put
   int threads = 0;        ///< threads for the passes (0: all cores); the result is the same for any
+  /// If set and raised, the smoothing stops before its next pass and throws Cancelled
+  /// (lib/Cancellation.h); the points are then left as they were.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct SmoothingReport {
@@ -43,7 +47,8 @@ struct SmoothingReport {
 /// \throw std::invalid_argument for parameters out of range, sizes that differ, a vertex index
 ///        out of range, a surfel direction outside 0-5, a vertex off its segment, or a triangle whose vertices lie in no single
 ///        cube (e.g. a decimated mesh); std::logic_error (requireClosedOrientedManifold,
-///        converter/SurfaceMesh.h) for triangles that are no closed, oriented 2-manifold.
+///        converter/SurfaceMesh.h) for triangles that are no closed, oriented 2-manifold;
+///        Cancelled when parameters.cancel is raised.
 SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfels,
                                  const std::vector<std::array<std::uint32_t, 3>>& triangles,
                                  const ImageGeometry& geometry, const SmoothingParameters& parameters = {});

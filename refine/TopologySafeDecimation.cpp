@@ -56,7 +56,8 @@ DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p
   if (p.targetReduction)
     report.targetTriangles = std::size_t(std::llround((1 - *p.targetReduction) * double(report.trianglesBefore)));
   auto& quadricModule = decimater.module(quadric);
-  decimater.decimateToFaces(report.targetTriangles, [&](const auto& ci) { return quadricModule.collapse_priority(ci); });
+  decimater.decimateToFaces(
+      report.targetTriangles, [&](const auto& ci) { return quadricModule.collapse_priority(ci); }, p.cancel);
   mesh.garbage_collection();
   report.trianglesAfter = mesh.n_faces();
   return report;

@@ -9,6 +9,7 @@
 // A halfedge collapse moves no vertex: the survivors keep their points and their surfels.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <optional>
 
@@ -24,6 +25,9 @@ struct DecimationParameters {
   /// as the other bounds allow.
   std::optional<double> targetReduction;
   double maxNormalDeviation = 60;  ///< degrees, in ]0, 180]
+  /// If set and raised, the decimation stops within a few thousand candidates and throws
+  /// Cancelled (lib/Cancellation.h); the mesh is then partly decimated.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct DecimationReport {
@@ -33,7 +37,8 @@ struct DecimationReport {
 
 /// Decimates `mesh` in place (a closed 2-manifold; vertex properties such as the surfels follow
 /// the surviving vertices), then collects the garbage.
-/// \throw std::invalid_argument for parameters out of range or a mesh with a boundary.
+/// \throw std::invalid_argument for parameters out of range or a mesh with a boundary;
+///        Cancelled when parameters.cancel is raised.
 DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& parameters);
 
 }  // namespace surftrack::refine

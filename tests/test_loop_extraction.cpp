@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <filesystem>
@@ -13,10 +14,12 @@
 #include <map>
 #include <numbers>
 #include <random>
+#include <system_error>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 
 #include "BoundaryMapping.h"
+#include "Cancellation.h"
 #include "CaseSubset.h"
 #include "LoopExtraction.h"
 #include "MeshChecks.h"
@@ -378,6 +381,51 @@ TEST_F(MeshFiles, TriangleListFilesEqualHalfedgeMeshFiles) {
   EXPECT_THROW(writeTriangles({}, {}, (dir_ / "mesh.xyz").string()), std::invalid_argument);
   EXPECT_THROW(writeTriangles({}, {}, (dir_ / "no" / "dir" / "mesh.ply").string()), std::runtime_error);
   EXPECT_EQ(filesInDir(), 12u);
+}
+
+// A path that cannot be written says why, with the system's errno (FileWriteError, a
+// std::system_error, converter/MeshIO.h): a missing directory, a file where a directory should
+// be, a path that is a directory (refused before anything is written, whatever its extension).
+TEST_F(MeshFiles, AnUnwritablePathSaysWhyWithItsErrno) {
+  const std::vector<std::array<double, 3>> points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  auto expectError = [&](const std::filesystem::path& path, int code, const std::string& why) {
+    SCOPED_TRACE(path.string());
+    try {
+      writeTriangles(points, triangles, path.string());
+      ADD_FAILURE() << "no error";
+    } catch (const std::system_error& e) {
+      EXPECT_EQ(e.code(), std::error_code(code, std::generic_category())) << e.what();
+      EXPECT_EQ(std::string(e.what()), "cannot write '" + path.string() + "': " + why);
+    }
+  };
+  expectError(dir_ / "no" / "dir" / "mesh.ply", ENOENT, "directory '" + (dir_ / "no" / "dir").string() + "' does not exist");
+  std::ofstream(dir_ / "file") << "x";
+  expectError(dir_ / "file" / "mesh.obj", ENOTDIR, "'" + (dir_ / "file").string() + "' is not a directory");
+  for (const std::string name : {"out.ply", "out.stl", "out"}) {
+    std::filesystem::create_directory(dir_ / name);
+    expectError(dir_ / name, EISDIR, "it is a directory");
+  }
+  EXPECT_EQ(filesInDir(), 4u) << "the file and the three directories only";
+}
+
+// A raised cancel flag stops writeTriangles in every format (the binary PLY writer between its
+// buffers, OpenMesh's writers through the exporter) with Cancelled, and the temporary file is
+// removed; a flag that stays down changes nothing.
+TEST_F(MeshFiles, ACancelledWriteLeavesNoFile) {
+  const std::vector<std::array<double, 3>> points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  const std::vector<std::pair<std::string, bool>> cases = {{"a.ply", true}, {"b.ply", false}, {"c.obj", true},
+                                                           {"d.off", true}, {"e.stl", true},  {"f.stl", false}};
+  std::atomic<bool> cancel{true};
+  for (const auto& [name, binary] : cases) {
+    SCOPED_TRACE(name);
+    EXPECT_THROW(writeTriangles(points, triangles, (dir_ / name).string(), binary, &cancel), Cancelled);
+    EXPECT_EQ(filesInDir(), 0u) << "no file, no temporary file";
+  }
+  cancel = false;
+  for (const auto& [name, binary] : cases) writeTriangles(points, triangles, (dir_ / name).string(), binary, &cancel);
+  EXPECT_EQ(filesInDir(), cases.size());
 }
 
 TEST_F(MeshFiles, UnknownExtensionAndUnwritablePathThrowAndLeaveNoFile) {

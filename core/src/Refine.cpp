@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "ConstrainedSmoothing.h"
 #include "PhysicalRange.h"
@@ -95,6 +96,9 @@ void requireSegmentsInRange(const Surface& surface) {
 }  // namespace
 
 SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
+  if (o.iterations > kMaxSmoothIterations)
+    throw InvalidInput("smoothing iterations " + std::to_string(o.iterations) + " is above the limit of " +
+                       std::to_string(kMaxSmoothIterations));
   requireSegmentsInRange(surface);
   refine::SmoothingParameters p;
   p.iterations = o.iterations;
@@ -102,6 +106,7 @@ SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
   p.mu = o.mu;
   p.epsilon = o.epsilon;
   p.threads = o.threads;
+  p.cancel = o.cancel;
   SmoothReport report;
   report.volumeBefore = volumeOf(surface);
   // Smoothing moves points only: it works on the surface's arrays, with no half-edge mesh.
@@ -126,6 +131,7 @@ DecimateReport decimate(Surface& surface, const DecimateOptions& o) {
   p.maxError = o.maxError;
   p.targetReduction = o.reduction;
   p.maxNormalDeviation = o.maxNormalDeviation;
+  p.cancel = o.cancel;
   DecimateReport report;
   report.volumeBefore = volumeOf(surface);
   SurfaceMesh mesh = meshOf(surface);

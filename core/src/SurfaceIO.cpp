@@ -13,7 +13,7 @@
 
 namespace surftrack {
 
-void writeSurface(const Surface& surface, const std::string& path, bool binary) {
+void writeSurface(const Surface& surface, const std::string& path, bool binary, const std::atomic<bool>* cancel) {
   // No half-edge mesh is needed to write a file: the triangles are checked as toSurfaceMesh
   // would check them, then written from the list (converter/MeshIO.h).
   try {
@@ -24,7 +24,7 @@ void writeSurface(const Surface& surface, const std::string& path, bool binary) 
     throw InternalError(e.what());
   }
   try {
-    writeTriangles(surface.vertices, surface.triangles, path, binary);
+    writeTriangles(surface.vertices, surface.triangles, path, binary, cancel);
   } catch (const std::invalid_argument& e) {
     throw InvalidInput(e.what());
   }

@@ -8,6 +8,12 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
+#include <chrono>
+#include <future>
+#include <regex>
+#include <system_error>
+
 #include <surftrack/Extract.h>
 #include <surftrack/Labels.h>
 #include <surftrack/Refine.h>
@@ -75,6 +81,93 @@ ScalarType scalarTypeOfDtype(const py::dtype& dtype) {
                        "': expected bool, uint8/16/32/64, int8/16/32/64, float32 or float64");
 }
 
+/// The largest volume dimension the engine takes (core/src/ViewSource.cpp: surfel keys hold 20
+/// bits per coordinate, with a voxel of margin on each side).
+constexpr int kMaxDimension = Surfel::kCoordinateLimit - 3;
+
+/// Runs `work` (engine code that touches no Python object without taking the GIL) on a worker
+/// thread while the calling thread watches for Ctrl-C: Python runs its signal handlers on the
+/// main thread only, between bytecodes, and the engine's long loops (tracking, scanning,
+/// smoothing, decimation, writing) check `cancel` instead. Every 50 ms the caller takes the GIL
+/// and runs the pending handlers (PyErr_CheckSignals); one that raises (KeyboardInterrupt for
+/// SIGINT) raises `cancel`, and once the work has stopped at its next check that exception is
+/// raised here. Otherwise the work's own exception, if any, is rethrown here.
+template <class Work>
+void runWatchingSignals(std::atomic<bool>& cancel, Work&& work) {
+  std::future<void> done = std::async(std::launch::async, std::forward<Work>(work));
+  for (;;) {
+    bool finished;
+    {
+      py::gil_scoped_release release;
+      finished = done.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready;
+    }
+    if (finished) break;
+    if (PyErr_CheckSignals() != 0) {
+      py::error_already_set interrupt;  // the handler's exception, fetched
+      cancel = true;
+      {
+        py::gil_scoped_release release;
+        done.wait();
+      }
+      try {
+        done.get();
+      } catch (...) {  // Cancelled, or whatever came first: the interrupt is what the caller asked
+      }
+      throw interrupt;
+    }
+  }
+  done.get();
+}
+
+/// Applies `format` to every match of `re` in `text`.
+template <class Format>
+std::string replaceMatches(const std::string& text, const std::regex& re, Format&& format) {
+  std::string out;
+  auto last = text.cbegin();
+  for (std::sregex_iterator it(text.begin(), text.end(), re), end; it != end; ++it) {
+    out.append(last, (*it)[0].first);
+    out += format(*it);
+    last = (*it)[0].second;
+  }
+  out.append(last, text.cend());
+  return out;
+}
+
+/// An engine message with its voxel coordinates in the caller's axes: the engine's x, y, z are
+/// the array axes order[0..2] (surftrack/__init__.py), and its messages print a voxel as
+/// "(x,y,z)" after "voxel ", "voxel index " or, in a surfel, "c=" and "d=", and a domain as
+/// "[0,nx)x[0,ny)x[0,nz)" (core/src/Extract.cpp, core/src/Labels.cpp). Physical points are in
+/// the caller's frame already and are left alone.
+std::string inArrayAxes(const std::string& message, std::array<int, 3> order) {
+  static const std::regex voxel(R"re((voxel |voxel index |c=|d=)\(([^,()]+),([^,()]+),([^,()]+)\))re");
+  static const std::regex domain(R"re(\[0,(\d+)\)x\[0,(\d+)\)x\[0,(\d+)\))re");
+  auto permuted = [&](const std::smatch& m, int first) {
+    std::array<std::string, 3> a;
+    for (int e = 0; e < 3; ++e) a[std::size_t(order[e])] = m[first + e].str();
+    return a;
+  };
+  const std::string voxels = replaceMatches(message, voxel, [&](const std::smatch& m) {
+    const auto a = permuted(m, 2);
+    return m[1].str() + "(" + a[0] + "," + a[1] + "," + a[2] + ")";
+  });
+  return replaceMatches(voxels, domain, [&](const std::smatch& m) {
+    const auto a = permuted(m, 1);
+    return "[0," + a[0] + ")x[0," + a[1] + ")x[0," + a[2] + ")";
+  });
+}
+
+/// runWatchingSignals for the engine's extractions: their errors' voxels in the caller's axes.
+template <class Work>
+void runEngine(std::array<int, 3> order, std::atomic<bool>& cancel, Work&& work) {
+  try {
+    runWatchingSignals(cancel, std::forward<Work>(work));
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(inArrayAxes(e.what(), order));
+  } catch (const InternalError& e) {
+    throw InternalError(inArrayAxes(e.what(), order));
+  }
+}
+
 /// A numpy array over `data` (shape `shape`), owned by the heap object `owner`: no copy.
 template <class T, class Owner>
 py::array_t<T> viewOf(T* data, std::vector<py::ssize_t> shape, std::shared_ptr<Owner> owner) {
@@ -128,7 +221,8 @@ VolumeView viewOfArray(const py::array& volume, std::array<int, 3> order, std::a
   for (int e = 0; e < 3; ++e) {
     const int a = order[e];
     if (volume.shape(a) == 0) throw py::value_error("the volume is empty (a dimension is 0)");
-    if (volume.shape(a) > (1 << 19) - 3) throw py::value_error("a volume dimension exceeds 524285");
+    if (volume.shape(a) > kMaxDimension)
+      throw py::value_error("a volume dimension exceeds " + std::to_string(kMaxDimension));
     if (volume.strides(a) % py::ssize_t(sizeOf(type)) != 0)
       throw py::value_error("the volume's strides are not multiples of its item size");
     (e == 0 ? view.dims.nx : e == 1 ? view.dims.ny : view.dims.nz) = int(volume.shape(a));
@@ -211,12 +305,15 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
   } else if (seedKind == "point") o.seed = SeedRule::point({seed[0], seed[1], seed[2]});
   else if (seedKind == "largest") o.seed = SeedRule::largest();
   else o.seed = SeedRule::all();
-  // Progress and Ctrl-C: the engine runs without the GIL and takes it back only here.
-  o.progress = [&](const ProgressEvent& e) {
-    py::gil_scoped_acquire gil;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    if (!progress.is_none()) progress(e.stage, e.index, e.stages, e.surfels);
-  };
+  // Ctrl-C: the caller's thread watches for it while the engine runs (runWatchingSignals).
+  std::atomic<bool> cancel{false};
+  o.cancel = &cancel;
+  // Progress: the engine runs without the GIL on its own thread and takes it back only here.
+  if (!progress.is_none())
+    o.progress = [&](const ProgressEvent& e) {
+      py::gil_scoped_acquire gil;
+      progress(e.stage, e.index, e.stages, e.surfels);
+    };
 
   auto r = std::make_shared<Result>();
   r->order = order;
@@ -225,20 +322,22 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     SmoothOptions so;
     so.iterations = smoothIterations;
     so.threads = threads;
+    so.cancel = &cancel;
     ro.smooth = so;
   }
+  ro.progress = o.progress;  // stages "smooth" and "decimate", numbered among themselves
   if (maxError || reduction) {
     DecimateOptions d;
     d.maxError = maxError;
     d.reduction = reduction;
+    d.cancel = &cancel;
     ro.decimate = d;
   }
   RefineReport refined;
-  {
-    py::gil_scoped_release release;
+  runEngine(order, cancel, [&] {
     r->surface = extract(view, o);
     refined = refineSurface(r->surface, ro);
-  }
+  });
   py::dict out = surfaceDict(r);
   const Surface& s = r->surface;
   if (s.seed.surfel) {
@@ -299,10 +398,9 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
   o.threads = threads;
   o.figures = figures;
   std::vector<LabelSurface> surfaces;
-  {
-    py::gil_scoped_release release;
-    surfaces = extractLabels(view, o);
-  }
+  std::atomic<bool> cancel{false};
+  o.cancel = &cancel;
+  runEngine(order, cancel, [&] { surfaces = extractLabels(view, o); });
   py::dict out;
   for (LabelSurface& ls : surfaces) {
     auto r = std::make_shared<Result>();
@@ -342,8 +440,8 @@ void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> 
       if (idx < 0 || std::size_t(idx) >= n) throw py::value_error("a face refers to a vertex that does not exist");
       s.triangles[t][k] = std::uint32_t(idx);
     }
-  py::gil_scoped_release release;
-  writeSurface(s, path, binary);
+  std::atomic<bool> cancel{false};
+  runWatchingSignals(cancel, [&] { writeSurface(s, path, binary, &cancel); });
 }
 
 }  // namespace
@@ -353,6 +451,22 @@ PYBIND11_MODULE(_surftrack, m) {
   py::register_exception<InvalidInput>(m, "InvalidInput", PyExc_ValueError);
   py::register_exception<InternalError>(m, "InternalError", PyExc_RuntimeError);
   py::register_exception<Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);
+  // A file that cannot be written (writeSurface): OSError with the system's errno, so Python
+  // picks its subclass (FileNotFoundError, PermissionError, IsADirectoryError, ...).
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const std::system_error& e) {
+      if (e.code().category() != std::generic_category() && e.code().category() != std::system_category()) throw;
+      py::object error = py::reinterpret_steal<py::object>(
+          PyObject_CallFunction(PyExc_OSError, "is", e.code().value(), e.what()));
+      if (!error) return;  // the call failed: its error is set
+      PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(error.ptr())), error.ptr());
+    }
+  });
+  m.attr("__version__") = SURFTRACK_VERSION;
+  m.attr("MAX_SMOOTH_ITERATIONS") = kMaxSmoothIterations;
+  m.attr("MAX_DIMENSION") = kMaxDimension;
   py::class_<Result, std::shared_ptr<Result>>(m, "Result")
       .def("normals", &Result::normals)
       .def("surfels", &Result::surfels);

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Callable, Optional, Sequence
 
+import os as _os
 import warnings as _warnings
 
 import numpy as np
@@ -17,6 +18,9 @@ from . import _surftrack
 from ._surftrack import Cancelled, InternalError, InvalidInput
 
 __all__ = ["extract", "label_surfaces", "marching_cubes", "Surface", "InvalidInput", "InternalError", "Cancelled"]
+
+#: The project's version (CMake's project VERSION, as ``surftrack --version`` prints it).
+__version__ = _surftrack.__version__
 
 _ADJACENCIES = ("26-6", "18-6", "6-18", "6-26")
 _MAPPINGS = ("linear", "midpoint", "default")
@@ -31,8 +35,8 @@ class Surface:
     surfels   (N, 2, 3) int32, the voxel pair (c, d) of each vertex: c selected, d not, as
               array indices (computed on first use)
     components  one dict per component (surfels, triangles, edges, euler, genus, area,
-              volume), by decreasing size
-    euler, genus  of the whole surface (sums over the components)
+              volume), by decreasing size; the counts, euler and genus are ints
+    euler, genus  of the whole surface (sums over the components), ints
     boundaries_in_image  mode "largest" / "all": the boundaries the scan found
     timings   seconds per stage of the C++ core
     seed_distance  seeded by a voxel or a point: the physical distance to the seed surfel
@@ -78,18 +82,21 @@ class Surface:
         return self._surfels
 
     _FIGURES = ("surfels", "triangles", "edges", "euler", "genus", "area", "volume")
+    _COUNTS = ("surfels", "triangles", "edges", "euler", "genus")
 
     @property
     def components(self) -> list:
         if not isinstance(self._components, list):
             table = np.asarray(self._components).reshape(-1, len(self._FIGURES))
+            # Every component is a closed orientable surface: its genus (2 - euler) / 2 is an
+            # integer (docs/theory.md), exact in the table's doubles.
             self._components = [
-                {k: (int(v) if k in ("surfels", "triangles", "edges", "euler") else float(v))
-                 for k, v in zip(self._FIGURES, row)} for row in table]
+                {k: (int(v) if k in self._COUNTS else float(v)) for k, v in zip(self._FIGURES, row)}
+                for row in table]
         return self._components
 
     @property
-    def genus(self) -> float:
+    def genus(self) -> int:
         return sum(c["genus"] for c in self.components)
 
     def __repr__(self) -> str:
@@ -97,11 +104,17 @@ class Surface:
                 f"{len(self.components)} component(s), euler {self.euler})")
 
     def write(self, path: str, binary: bool = True) -> None:
-        """Writes .ply, .obj, .off or .stl (the CLI's writers; atomic: never a partial file)."""
+        """Writes .ply, .obj, .off or .stl (the CLI's writers; atomic: never a partial file).
+
+        Raises ValueError for an unknown extension, OSError (with ``errno``; e.g.
+        FileNotFoundError, PermissionError, IsADirectoryError) naming the path and the reason
+        when it cannot be written, KeyboardInterrupt on Ctrl-C (nothing written)."""
         _surftrack.write_arrays(self.vertices, self.faces, self.surfels, str(path), binary)
 
 
 def _as_volume(volume) -> np.ndarray:
+    """The volume as an array the engine reads in place; checked before any voxel is read (a
+    broadcast array can have a vast shape over a single value)."""
     array = np.asarray(volume)
     if array.dtype.kind not in "biuf":
         raise TypeError(f"unsupported volume dtype '{array.dtype}': expected bool, "
@@ -110,6 +123,9 @@ def _as_volume(volume) -> np.ndarray:
         raise ValueError(f"the volume must be 3-D, not {array.ndim}-D")
     if array.size == 0:
         raise ValueError(f"the volume is empty (shape {array.shape})")
+    if max(array.shape) > _surftrack.MAX_DIMENSION:
+        raise ValueError(f"volume shape {array.shape} is not supported: each dimension must be "
+                         f"at most {_surftrack.MAX_DIMENSION}")
     if not array.dtype.isnative:
         array = array.astype(array.dtype.newbyteorder("="))
     if array.dtype.kind == "b":
@@ -125,6 +141,25 @@ def _triple(name: str, value, default) -> tuple:
     if len(out) != 3 or not all(np.isfinite(out)):
         raise ValueError(f"{name} must be three finite numbers, not {value!r}")
     return out
+
+
+def _available_cpus() -> int:
+    """The CPUs this process may run on (its affinity mask, as TBB counts them)."""
+    try:
+        return len(_os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return _os.cpu_count() or 1
+
+
+def _thread_count(threads) -> int:
+    """``threads`` checked: an int >= 0 (0: all cores), larger counts lowered to the CPUs
+    available, since the surface is the same for any count and more threads than CPUs only
+    wait for each other."""
+    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)):
+        raise TypeError(f"threads must be an integer (0: all cores), not {threads!r}")
+    if threads < 0:
+        raise ValueError(f"threads {threads} is negative (0: all cores)")
+    return min(int(threads), _available_cpus())
 
 
 def _split_affine(affine):
@@ -171,20 +206,22 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
     The selected voxels are ``volume > level`` or ``volume == label``. ``seed`` is a voxel index
     ``(i, j, k)`` or a surfel ``((i, j, k), (i2, j2, k2))``; ``seed_point`` is a physical point.
     A voxel or a point resolves to the boundary surfel nearest it (``seed_rule="nearest"``);
-    ``seed_rule="ray"`` walks from the voxel along +i, -i, +j, -j, +k, -k to the first boundary
-    crossed instead; the nearest surfel is searched for up to ``max_seed_distance`` voxels (of
-    the smallest spacing; default 256, ``float('inf')`` for no bound), and a seed farther from
-    every boundary is a ValueError rather than a read of the whole volume. ``mapping`` places each
+    ``seed_rule="ray"`` walks from the voxel along +k, -k, +j, -j, +i, -i (the last axis first)
+    to the first boundary crossed instead; the nearest surfel is searched for up to
+    ``max_seed_distance`` voxels (of the smallest spacing; default 256, ``float('inf')`` for no
+    bound), and a seed farther from every boundary is a ValueError rather than a read of the
+    whole volume. ``mapping`` places each
     vertex on its surfel's segment: "linear" (iso-value interpolation, the default for a
     level), "midpoint" (the default for a label). ``progress(stage, index, stages, surfels)``
-    is called at each stage and while tracking. ``threads`` (0: all cores) runs the scan of
+    is called at each stage and while tracking. ``threads`` (an int, 0: all cores; more than
+    the CPUs available count as those) runs the scan of
     "largest" and "all" and the smoothing in parallel; the surface is the same for any number. ``figures=False``
     skips the per-component figures (``components`` empty, ``euler`` 0). ``affine`` (a 4x4 voxel-to-world matrix, as
     nibabel's ``img.affine``) replaces spacing, origin and direction. ``smooth=N`` smooths
-    with N Taubin iterations, every vertex kept on its surfel's segment (the same voxels
-    inside, the same topology); ``max_error`` (physical units) and/or ``reduce`` (the fraction
+    with N Taubin iterations (at most 100000, as the CLI), every vertex kept on its surfel's
+    segment (the same voxels inside, the same topology); ``max_error`` (physical units) and/or ``reduce`` (the fraction
     of triangles to remove) then decimate without changing the topology (docs/python.md).
-    Raises ValueError / TypeError on bad input.
+    Raises ValueError / TypeError on bad input; Ctrl-C stops any stage (KeyboardInterrupt).
     """
     array = _as_volume(volume)
     if affine is not None:
@@ -196,6 +233,10 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
             raise ValueError("give either level or label, not both")
     if int(smooth) != smooth or smooth < 0:
         raise ValueError(f"smooth takes a number of iterations >= 0, not {smooth!r}")
+    if smooth > _surftrack.MAX_SMOOTH_ITERATIONS:
+        raise ValueError(f"smooth takes at most {_surftrack.MAX_SMOOTH_ITERATIONS} iterations "
+                         f"(as the CLI's --smooth), not {smooth!r}")
+    threads = _thread_count(threads)
     if mode not in ("seed", "largest", "all"):
         raise ValueError(f"unknown mode '{mode}': expected 'seed', 'largest' or 'all'")
     if not float(max_seed_distance) > 0:
@@ -253,7 +294,7 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
                                        float(max_seed_distance))
     except ValueError as error:
         note = _range_note(array, value) if kind == "threshold" else ""
-        raise ValueError(f"{error}{note}") from None
+        raise type(error)(f"{error}{note}") from None
     surface = Surface(**out)
     for message in surface.warnings:
         _warnings.warn(message, stacklevel=2)
@@ -309,6 +350,7 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
         if s.ndim != 2 or s.shape[1] != 3 or len(s) == 0 or np.any(s != np.round(s)):
             raise ValueError(f"seeds must be voxel indices [(i, j, k), ...], not {seeds!r}")
         seed_list = [tuple(int(v) for v in row) for row in s]
+    threads = _thread_count(threads)
     spacing, origin, direction = _geometry(spacing, origin, direction)
     # The axes as in extract(); the scan reads rows, so a C-ordered copy if need be.
     if not array.flags.c_contiguous:

@@ -11,8 +11,12 @@ tar -C "$source" --exclude=./build --exclude=./.git -cf - . | (mkdir -p "$work/s
 "$work/venv/bin/pip" install --no-build-isolation --no-deps --no-index -q "$work/src"
 cd "$work"
 "$work/venv/bin/python" - <<'PY'
+import importlib.metadata
 import numpy as np, surftrack
 assert "venv" in surftrack.__file__, surftrack.__file__
+# One version: pip's metadata (setup.py, from CMakeLists.txt) and the module's (CMake).
+assert importlib.metadata.version("surftrack") == surftrack.__version__, (
+    importlib.metadata.version("surftrack"), surftrack.__version__)
 x = np.indices((20, 20, 20)) - 9.5
 s = surftrack.extract((x ** 2).sum(0) < 36, level=0.5, seed=(10, 10, 10))
 assert s.euler == 2 and len(s.faces) > 0, (s.euler, len(s.faces))

@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 
+#include "Cancellation.h"  // Cancelled: the caller's flag was raised
+
 namespace surftrack {
 
 /// Bad input: a volume, selection, seed or option the caller can correct.
@@ -24,12 +26,6 @@ class SeedTooFar : public InvalidInput {
 class InternalError : public std::logic_error {
  public:
   using std::logic_error::logic_error;
-};
-
-/// The caller's cancellation flag was raised during an extraction.
-class Cancelled : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
 };
 
 }  // namespace surftrack

@@ -181,8 +181,12 @@ std::vector<ComponentFigures> componentFigures(
 
 /// Writes the surface to `path` with OpenMesh's IO, the format from the extension (.ply, .obj,
 /// .off, .stl; `binary` for .ply and .stl), through a temporary file renamed over `path`, so a
-/// failure never leaves a partial file. \throw InvalidInput for an unknown extension, std::runtime_error naming the path
-/// when it cannot be written.
-void writeSurface(const Surface& surface, const std::string& path, bool binary = true);
+/// failure never leaves a partial file. `cancel`, if set, is checked every 2^16 vertices or
+/// triangles written. \throw InvalidInput for an unknown extension; std::system_error (a
+/// std::runtime_error) when `path` cannot be written, its code() the system's errno and its
+/// message naming the path and the reason ("cannot write 'out/a.ply': directory 'out' does not
+/// exist"); Cancelled when `cancel` is raised (the temporary file removed, `path` untouched).
+void writeSurface(const Surface& surface, const std::string& path, bool binary = true,
+                  const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace surftrack

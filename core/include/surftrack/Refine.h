@@ -11,6 +11,7 @@
 //   surftrack::refineSurface(s, {surftrack::SmoothOptions{}, d});
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <optional>
@@ -19,12 +20,19 @@
 
 namespace surftrack {
 
+/// The most smoothing iterations smooth() takes (the CLI's --smooth and Python's smooth= have
+/// the same limit): the smoothing has long settled on the segments by then, and a larger count
+/// is a typo that would keep the machine busy for hours.
+inline constexpr int kMaxSmoothIterations = 100000;
+
 struct SmoothOptions {
-  int iterations = 20;    ///< Taubin lambda|mu pairs of passes (0: nothing moves)
+  int iterations = 20;    ///< Taubin lambda|mu pairs of passes, in [0, kMaxSmoothIterations] (0: nothing moves)
   double lambda = 0.7;    ///< the strength: the shrinking pass's factor, in ]0, 1]
   double mu = -0.73;      ///< the inflating pass's factor, mu < -lambda, mu >= -1
   double epsilon = 1e-3;  ///< each vertex stays at t in [epsilon, 1 - epsilon] of its segment
   int threads = 0;        ///< threads for the passes (0: all cores); the same result for any number
+  /// If set and raised, smooth() stops before its next pass and throws Cancelled.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct SmoothReport {
@@ -43,6 +51,9 @@ struct DecimateOptions {
   /// Fraction of the triangles to remove, in [0, 1[ (as VTK's TargetReduction).
   std::optional<double> reduction;
   double maxNormalDeviation = 60;  ///< degrees: no collapse turns a triangle normal more (OpenMesh's normal-flip guard, per collapse)
+  /// If set and raised, decimate() stops within a few thousand collapse candidates and throws
+  /// Cancelled.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct DecimateReport {
@@ -56,15 +67,18 @@ struct DecimateReport {
 /// surface.geometry) and a fold check per digital 3-cube. Vertices, triangles and surfels keep
 /// their indices; the figures are recomputed.
 /// \pre surface is as extract() returns it (not decimated).
-/// \throw InvalidInput for options out of range, or a surface that is not a continuous analog
-///        (a decimated one, or vertices moved off their segments).
+/// \throw InvalidInput for options out of range (more than kMaxSmoothIterations among them),
+///        or a surface that is not a continuous analog (a decimated one, or vertices moved off
+///        their segments); Cancelled when options.cancel is raised (the surface is then
+///        unchanged).
 SmoothReport smooth(Surface& surface, const SmoothOptions& options = {});
 
 /// Decimates `surface` in place by halfedge collapses (OpenMesh's Decimater) under the link
 /// condition, a normal-flip guard and the error bound, up to the reduction if one is given.
 /// Surviving vertices keep their points and surfels; vertex indices are renumbered. The figures
 /// are recomputed.
-/// \throw InvalidInput for options out of range, or neither a maxError nor a reduction.
+/// \throw InvalidInput for options out of range, or neither a maxError nor a reduction;
+///        Cancelled when options.cancel is raised (the surface is then unchanged).
 DecimateReport decimate(Surface& surface, const DecimateOptions& options);
 
 /// Smoothing, then decimation, each if asked (the CLI's --smooth, --max-error, --reduce and
@@ -83,7 +97,7 @@ struct RefineReport {
 };
 
 /// smooth() then decimate() of `surface` as `options` asks (nothing asked: nothing changes).
-/// \throw InvalidInput as smooth() and decimate() do.
+/// \throw InvalidInput and Cancelled as smooth() and decimate() do.
 RefineReport refineSurface(Surface& surface, const RefineOptions& options);
 
 }  // namespace surftrack
