@@ -1,6 +1,8 @@
-// _surftrack: the Python binding of the front door (docs/python.md). It only translates: numpy
+// _surftrack: the Python binding of the front door (docs/python.md). It translates: numpy
 // arrays to VolumeViews (no copy), Python arguments to ExtractOptions, a Surface to numpy
-// arrays. The axis handling and the defaults live in surftrack/__init__.py.
+// arrays, the engine's errors to Python's (voxels in the caller's axes, OSError for files), and
+// Ctrl-C to the engine's cancel flag (the engine runs on a thread of its own). The axis handling
+// and the defaults live in surftrack/__init__.py.
 #include <cmath>
 
 #include <pybind11/functional.h>
