@@ -28,6 +28,7 @@
 
 #include "LoadVolume.h"
 #include "ReadVolume.h"
+#include "VolumeHeader.h"
 
 namespace fs = std::filesystem;
 using namespace surftrack;
@@ -520,7 +521,10 @@ TEST(LoadVolume, NumberedAndListedDataFilesAreDecodedByItk) {
   const std::string list = dir / "list.nhdr";
   writeFile(list, nrrdHeader("uint16", kDims, "endian: little\nencoding: raw\ndata file: LIST\n") +
                       "slice1.raw\nslice2.raw\nslice3.raw\n");
-  for (const std::string& path : {mhd, nhdr, list}) {
+  // A MetaImage list whose last name ends the file without its newline (MetaIO reads it).
+  const std::string metaList = dir / "list.mhd";
+  writeFile(metaList, metaHeader("MET_USHORT", kDims, "", "LIST") + "slice1.raw\nslice2.raw\nslice3.raw");
+  for (const std::string& path : {mhd, nhdr, list, metaList}) {
     const LoadedVolume loaded = io::loadVolume(path);
     EXPECT_FALSE(loaded.mapped) << path;
     EXPECT_NE(loaded.decodeReason.find("files"), std::string::npos) << loaded.decodeReason;
@@ -833,6 +837,10 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
       {"missinglist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nnowhere.raw\nok.raw\n", "no such file"},
       {"dirlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\n.\nok.raw\n", "directory"},
       {"shortfile.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\ntiny.raw\nok.raw\n", "truncated"},
+      // A list cut short after a name without its newline: the parser read past its buffer
+      // (std::out_of_range, found by fuzz/).
+      {"cutlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nok.raw", "lists 2 data files"},
+      {"cutlist1.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ab", "lists 1 data files"},
       // ITK's matrix code aborts on the infinity 1e200 * 1e200 makes.
       {"huge.mha", "ObjectType = Image\nNDims = 3\nDimSize = 7 5 3\nElementSpacing = 1e200 1e200 1e200\n"
                    "TransformMatrix = 1e200 0 0 0 1e200 0 0 0 1e200\nElementType = MET_SHORT\nElementDataFile = LOCAL\n" + data,
@@ -911,6 +919,48 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
     writeFile(locked, okNrrd + "\n" + data);
     fs::permissions(locked, fs::perms::none);
     expectReadError([&] { io::loadVolume(locked); }, {locked});
+  }
+}
+
+/// Every prefix of a valid header, parsed as a whole file and as the head of a longer one: the
+/// parsers of io/VolumeHeader.h give a layout, ask for more bytes (only of a longer file) or
+/// throw HeaderError — never another exception (a substr past the buffer throws
+/// std::out_of_range), whatever byte the cut falls on.
+TEST(LoadVolume, EveryCutOfAHeaderIsAHeaderErrorOrMoreBytes) {
+  TempDir dir;
+  std::vector<std::pair<std::string, std::string>> files = {
+      {"mhd", metaHeader("MET_SHORT", kDims, "ElementNumberOfChannels = 1\n", "LIST") + "a.raw\nb.raw\r\nc.raw\n"},
+      {"mhd", metaHeader("MET_SHORT", kDims, "", "slice%03d.raw 1 3 1")},
+      {"nhdr", nrrdHeader("int16", kDims, "endian: little\nencoding: raw\ndata file: LIST\n") + "a.raw\r\nb.raw\rc.raw\n"},
+      {"nhdr", nrrdHeader("int16", kDims, "endian: little\nencoding: raw\ndata file: s%02d.raw 1 3 1 2\n")},
+  };
+  for (const std::string ext : {"nii", "nrrd", "mha"}) {
+    const std::string path = dir / ("cut." + ext);
+    io::writeVolume(io::AnyVolume(makeVolume<std::int16_t>(kDims)), path);
+    files.emplace_back(ext, contents(path));
+  }
+  for (const auto& [ext, bytes] : files) {
+    const auto parse = ext == "nii" ? io::parseNifti1Header
+                     : ext == "mha" || ext == "mhd" ? io::parseMetaImageHeader
+                                                    : io::parseNrrdHeader;
+    int layouts = 0;
+    for (std::size_t n = 0; n <= bytes.size(); ++n) {
+      const std::string head = bytes.substr(0, n);  // (a buffer of exactly n bytes)
+      for (const std::uint64_t fileSize : {std::uint64_t(n), std::uint64_t(bytes.size())}) {
+        SCOPED_TRACE(ext + ": the first " + std::to_string(n) + " of " + std::to_string(bytes.size()) +
+                     " bytes, of a file of " + std::to_string(fileSize));
+        try {
+          const auto layout = parse(head, fileSize);
+          if (!layout) EXPECT_LT(n, fileSize) << "more bytes asked of a whole file";
+          layouts += layout.has_value();
+        } catch (const io::HeaderError& e) {
+          EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+        } catch (const std::exception& e) {
+          ADD_FAILURE() << "not a HeaderError: " << e.what();
+        }
+      }
+    }
+    EXPECT_GT(layouts, 0) << ext << ": the whole header never parsed";
   }
 }
 
