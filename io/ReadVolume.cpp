@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <regex>
 #include <sstream>
 #include <tuple>
 #include <utility>
@@ -60,21 +61,40 @@ void registerFactories() {
   });
 }
 
-/// An ITK exception's description on one line.
+/// An ITK exception as one line for a user: its description with white space collapsed,
+/// without ITK's "ITK ERROR: NrrdImageIO(0x55e4aa74c3b0): " (a pointer tells a user nothing;
+/// the reader's name is kept, as "ITK's NrrdImageIO: "), and of teem's chain of messages
+/// "[nrrd] nrrdLoad: trouble ... [nrrd] _nrrdEncodingGzip_read: expected 48 bytes but received
+/// 44" (ITK's NRRD reader) only the last one, which says what is wrong.
 std::string oneLine(const itk::ExceptionObject& e) {
-  std::string text = e.GetDescription() ? e.GetDescription() : "";
-  std::string out;
+  std::string text;
   bool space = false;
-  for (char ch : text) {
+  for (const char* p = e.GetDescription() ? e.GetDescription() : ""; *p; ++p) {
+    const char ch = *p;
     if (ch == '\n' || ch == '\r' || ch == '\t' || ch == ' ') {
-      space = !out.empty();
+      space = !text.empty();
       continue;
     }
-    if (space) out += ' ';
+    if (space) text += ' ';
     space = false;
-    out += ch;
+    text += ch;
   }
-  return out.empty() ? "ITK error" : out;
+  static const std::regex prefix(R"(^(ITK ERROR: )?([A-Za-z_][A-Za-z0-9_:]*)\(0x[0-9a-fA-F]+\): )");
+  std::string reader;
+  std::smatch m;
+  if (std::regex_search(text, m, prefix)) {
+    reader = m[2].str();
+    text = m.suffix().str();
+  } else if (text.rfind("ITK ERROR: ", 0) == 0) {
+    text.erase(0, 11);
+  }
+  if (const std::size_t last = text.rfind("[nrrd] "); last != std::string::npos) {
+    text.erase(0, last + 7);
+    static const std::regex function(R"(^[A-Za-z_][A-Za-z0-9_]*: )");
+    text = std::regex_replace(text, function, "", std::regex_constants::format_first_only);
+  }
+  if (text.empty()) text = "unknown error";
+  return reader.empty() ? "ITK: " + text : "ITK's " + reader + ": " + text;
 }
 
 std::string componentName(itk::IOComponentEnum c) {
@@ -166,9 +186,16 @@ ImagePointer<T> readSeriesAs(const std::vector<std::string>& files) {
   return image;
 }
 
-std::string unsupportedType(const std::string& path, const std::string& what) {
-  return "unsupported voxel type " + what + " in '" + path +
-         "': supported are uint8, int16, uint16, int32, float and double";
+/// A ReadError for voxels surftrack does not read: `what` says what they are ("its voxels have
+/// 3 components", "its voxel type is 'long double'").
+ReadError unsupportedType(const std::string& path, const std::string& what) {
+  return ReadError("cannot read '" + path + "': " + what + "; surftrack reads one scalar per voxel, of type " +
+                   supportedTypesText());
+}
+
+/// "its voxels have N components (RGB, complex or vector voxels)".
+std::string componentsText(unsigned components) {
+  return "its voxels have " + std::to_string(components) + " components (RGB, complex or vector voxels)";
 }
 
 /// Reads the first DICOM series of a directory and hands the image to `use`.
@@ -185,10 +212,9 @@ auto readDicomDirectory(const std::string& path, Use&& use) {
   dicom->SetFileName(files.front());
   dicom->ReadImageInformation();
   if (dicom->GetNumberOfComponents() != 1)
-    throw ReadError(unsupportedType(path, "with " + std::to_string(dicom->GetNumberOfComponents()) +
-                                              " components per voxel"));
+    throw unsupportedType(path, componentsText(dicom->GetNumberOfComponents()));
   const auto type = scalarTypeOf(dicom->GetComponentType());
-  if (!type) throw ReadError(unsupportedType(path, "'" + componentName(dicom->GetComponentType()) + "'"));
+  if (!type) throw unsupportedType(path, "its voxel type is '" + componentName(dicom->GetComponentType()) + "'");
   return visitScalarType(*type, [&](auto v) { return use(readSeriesAs<decltype(v)>(files), std::string("dicom")); });
 }
 
@@ -376,10 +402,9 @@ itk::ImageIOBase::Pointer openImageIO(const std::string& path, ScalarType& type,
                       "D image with more than one volume; give a 3D image");
   }
   if (imageIO->GetNumberOfComponents() != 1)
-    throw ReadError(unsupportedType(
-        path, "with " + std::to_string(imageIO->GetNumberOfComponents()) + " components per voxel"));
+    throw unsupportedType(path, componentsText(imageIO->GetNumberOfComponents()));
   const auto t = scalarTypeOf(imageIO->GetComponentType());
-  if (!t) throw ReadError(unsupportedType(path, "'" + componentName(imageIO->GetComponentType()) + "'"));
+  if (!t) throw unsupportedType(path, "its voxel type is '" + componentName(imageIO->GetComponentType()) + "'");
   type = *t;
   return imageIO;
 }

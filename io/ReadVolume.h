@@ -29,6 +29,10 @@ using AnyVolume = std::variant<DenseImage<std::uint8_t>, DenseImage<std::int8_t>
                                DenseImage<std::uint64_t>, DenseImage<std::int64_t>,
                                DenseImage<float>, DenseImage<double>>;
 
+/// "uint8, int8, uint16, int16, uint32, int32, uint64, int64, float or double": the voxel types
+/// a volume may have (one scalar per voxel), for messages.
+std::string supportedTypesText();
+
 ScalarType scalarTypeOf(const AnyVolume& volume);
 const Dims& dimsOf(const AnyVolume& volume);
 const ImageGeometry& geometryOf(const AnyVolume& volume);

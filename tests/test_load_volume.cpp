@@ -313,7 +313,9 @@ TYPED_TEST(LoadEveryType, CompressedFilesAreDecodedOnce) {
     // A .nii.gz is inflated by the loader, its voxels 64-byte aligned; the others by ITK.
     const bool gzippedNifti = name == "c.nii.gz";
     EXPECT_NE(loaded.decodeReason.find(gzippedNifti ? "inflated into memory" : "ITK"), std::string::npos) << loaded.decodeReason;
-    if (gzippedNifti) EXPECT_EQ(reinterpret_cast<std::uintptr_t>(loaded.view.data) % 64, 0u);
+    if (gzippedNifti) {
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(loaded.view.data) % 64, 0u);
+    }
     expectSame(loaded, io::readVolume(path), path);
     expectVoxels(loaded, image);
   }
@@ -901,6 +903,26 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
     cases.push_back({"nifti2size.nii", mixed, "sizeof_hdr 540"});
     const float far = 1e24f;
     cases.push_back({"faroffset.nii", with(108, &far, 4), "truncated"});
+    // An sform singular to single precision, with an offset of 5e7 beside 3e-39 (a fuzzer's
+    // finding): ITK 5.2's NIfTI reader never returned on it.
+    {
+      std::string b = bytes;
+      const std::int16_t qformCode = 0, sformCode = 1;
+      const float sform[12] = {1, 0, -5e7f, 0, 1, 0, 1, 3e-39f, 0, 1, 5e7f, 0};
+      std::memcpy(&b[252], &qformCode, 2);
+      std::memcpy(&b[254], &sformCode, 2);
+      std::memcpy(&b[280], sform, sizeof sform);
+      cases.push_back({"singularsform.nii", b, "sform (srow_x to srow_z) is singular"});
+      // Found by a search of random sforms on which ITK's SVD never returns: a rotation of
+      // 1 um voxels (in mm) beside offsets of 4e12 and 2.6e-30.
+      const float regular[12] = {0.00107906f, 0.000295631f, 0, -4.1007e+12f, -0.000295631f, 0.00107906f, 0, 0,
+                                 0, 0, 0.00146083f, -2.58811e-30f};
+      std::memcpy(&b[280], regular, sizeof regular);
+      cases.push_back({"offsetsform.nii", b, "more than 1e24 apart"});
+    }
+    // Datatypes niftilib rejects with a line of its own on stderr, or that are not one scalar.
+    const std::int16_t badType = 9999;
+    cases.push_back({"datatype.nii", with(70, &badType, 2), "datatype 9999 is not a NIfTI-1 datatype"});
   }
   for (const Case& c : cases) {
     const std::string path = dir / c.name;
@@ -919,6 +941,107 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
     writeFile(locked, okNrrd + "\n" + data);
     fs::permissions(locked, fs::perms::none);
     expectReadError([&] { io::loadVolume(locked); }, {locked});
+  }
+}
+
+/// A NIfTI sform with small voxels far from the origin (1 um voxels, in mm, half a metre away:
+/// a condition number near 1e9) is not refused with the singular ones above: ITK reads it (from
+/// the qform it falls back to), with the geometry it was written with.
+TEST(LoadVolume, SmallVoxelsFarFromTheOriginLoad) {
+  TempDir dir;
+  ImageGeometry g = testGeometry();
+  g.spacing = {1e-3, 1e-3, 2e-3};
+  g.origin = {500, -400, 300};
+  const std::string path = dir / "far.nii";
+  io::writeVolume(io::AnyVolume(makeVolume<std::int16_t>(kDims, g)), path);
+  const LoadedVolume loaded = io::loadVolume(path);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(loaded.view.geometry.spacing[i], g.spacing[i], 1e-8);
+    EXPECT_NEAR(loaded.view.geometry.origin[i], g.origin[i], 1e-3);
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(loaded.view.geometry.direction[i][j], g.direction[i][j], 1e-5);
+  }
+}
+
+/// What ITK refuses reaches the user as one line without ITK's pointers ("NrrdImageIO(0x55...)")
+/// or its "ITK ERROR:", saying what is wrong, and nothing else is printed on stderr.
+TEST(LoadVolume, ItkErrorsAreOneLineWithoutPointers) {
+  TempDir dir;
+  // gzip-encoded voxels that end early: teem's chain of messages ends with what is wrong.
+  const std::string cut = dir / "cut.nrrd";
+  const std::string full = gzipped(std::string(7 * 5 * 3 * 2, '\5'));
+  writeFile(cut, nrrdHeader("int16", kDims, "endian: little\nencoding: gzip\n") + "\n" + full.substr(0, full.size() - 12));
+  // A NIfTI datatype niftilib does not know: refused before niftilib prints its own line.
+  const std::string nifti = dir / "datatype.nii";
+  io::writeVolume(io::AnyVolume(makeVolume<std::int16_t>(kDims)), nifti);
+  std::string bytes = contents(nifti);
+  const std::int16_t badType = 1;  // DT_BINARY: niftilib's "bad datatype"
+  std::memcpy(&bytes[70], &badType, 2);
+  writeFile(nifti, bytes);
+  for (const std::string& path : {cut, nifti}) {
+    SCOPED_TRACE(path);
+    testing::internal::CaptureStderr();
+    std::string message;
+    try {
+      io::loadVolume(path);
+    } catch (const io::ReadError& e) {
+      message = e.what();
+    }
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_EQ(message.find("(0x"), std::string::npos) << message;
+    EXPECT_EQ(message.find("ITK ERROR"), std::string::npos) << message;
+    EXPECT_EQ(message.find("[nrrd]"), std::string::npos) << message;
+    EXPECT_EQ(err, "") << "printed on stderr besides the error";
+  }
+}
+
+/// A file whose voxels are not one scalar of a supported type: the message lists the types, and
+/// every type it lists loads (as a NRRD file written here, the type by the message's name).
+TEST(LoadVolume, UnsupportedVoxelsNameTheTypesThatLoad) {
+  TempDir dir;
+  const std::string nifti = dir / "complex.nii";  // NIfTI complex64
+  io::writeVolume(io::AnyVolume(makeVolume<float>(kDims)), nifti);
+  std::string bytes = contents(nifti);
+  const std::int16_t complex64 = 32, bits = 64;
+  std::memcpy(&bytes[70], &complex64, 2);
+  std::memcpy(&bytes[72], &bits, 2);
+  writeFile(nifti, bytes + std::string(kDims.count() * 4, '\0'));
+  const std::string channels = dir / "channels.mha";  // three channels per voxel: ITK's vector
+  writeFile(channels, metaHeader("MET_UCHAR", kDims, "ElementNumberOfChannels = 3\n", "LOCAL") +
+                          std::string(kDims.count() * 3, '\7'));
+  for (const auto& [path, what] : {std::pair{nifti, std::string("complex64")}, std::pair{channels, std::string("3 components")}}) {
+    SCOPED_TRACE(path);
+    std::string message;
+    try {
+      io::loadVolume(path);
+      ADD_FAILURE() << "loaded";
+    } catch (const io::ReadError& e) {
+      message = e.what();
+    }
+    EXPECT_NE(message.find(what), std::string::npos) << message;
+    const std::string lead = "of type ";
+    const std::size_t at = message.find(lead);
+    ASSERT_NE(at, std::string::npos) << message;
+    std::vector<std::string> names;
+    std::string list = message.substr(at + lead.size());
+    for (std::size_t start = 0;;) {
+      std::size_t end = list.find(", ", start);
+      const std::size_t orAt = list.find(" or ", start);
+      if (end == std::string::npos || (orAt != std::string::npos && orAt < end)) end = orAt;
+      names.push_back(list.substr(start, end == std::string::npos ? std::string::npos : end - start));
+      if (end == std::string::npos) break;
+      start = end + (list.compare(end, 4, " or ") == 0 ? 4 : 2);
+    }
+    EXPECT_EQ(names.size(), 10u) << message;
+    for (const std::string& name : names) {
+      const ScalarType type = io::parseScalarType(name);
+      const std::string file = dir / ("listed-" + name + ".nrrd");
+      writeFile(file, nrrdHeader(name, kDims, "endian: little\nencoding: raw\n") + "\n" +
+                          std::string(kDims.count() * sizeOf(type), '\1'));
+      const LoadedVolume loaded = io::loadVolume(file);
+      EXPECT_EQ(loaded.view.type, type) << name;
+    }
   }
 }
 
@@ -951,7 +1074,9 @@ TEST(LoadVolume, EveryCutOfAHeaderIsAHeaderErrorOrMoreBytes) {
                      " bytes, of a file of " + std::to_string(fileSize));
         try {
           const auto layout = parse(head, fileSize);
-          if (!layout) EXPECT_LT(n, fileSize) << "more bytes asked of a whole file";
+          if (!layout) {
+            EXPECT_LT(n, fileSize) << "more bytes asked of a whole file";
+          }
           layouts += layout.has_value();
         } catch (const io::HeaderError& e) {
           EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
