@@ -81,8 +81,18 @@ void requireSame(const io::LoadedVolume& loaded, const io::AnyVolume& read) {
   std::visit([&](const auto& image) {
     const std::size_t size = sizeOf(loaded.view.type);
     const auto* p = static_cast<const unsigned char*>(loaded.view.data);
-    if (std::memcmp(p, image.data().data(), image.data().size() * size) != 0)
-      fail("loadVolume and readVolume disagree on the voxels");
+    for (std::size_t i = 0; i < image.data().size(); ++i)
+      if (std::memcmp(p + i * size, &image.data()[i], size) != 0) {
+        double a = 0;
+        visitScalarType(loaded.view.type, [&](auto t) {
+          decltype(t) v;
+          std::memcpy(&v, p + i * size, size);
+          a = double(v);
+        });
+        fail("loadVolume and readVolume disagree on voxel " + std::to_string(i) + ": " + std::to_string(a) + " (" +
+             std::to_string(a == 0 ? 0 : std::log10(std::abs(a))) + " decades) against " +
+             std::to_string(double(image.data()[i])) + " (" + loaded.decodeReason + ")");
+      }
   }, read);
 }
 

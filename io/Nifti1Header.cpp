@@ -255,9 +255,13 @@ std::optional<DataLayout> parseNifti1Header(std::string_view head, std::uint64_t
   layout.bigEndian = swapped && sizeOf(*type) > 1;
   if (layout.bigEndian) because("its voxels are big-endian");
 
-  // scl_slope = 0 means no scaling; ITK rescales (and may change the voxel type) otherwise.
-  const float slope = r.get<float>(112), inter = r.get<float>(116);
-  if (slope != 0 && (slope != 1 || inter != 0)) because("its voxels are scaled (scl_slope, scl_inter)");
+  // The NIfTI-1 header calls scl_slope = 0 unscaled, but ITK 5.2 reads it as a slope of 1 and
+  // adds scl_inter (niftilib reads a non-finite slope or intercept as 0 first): only a slope of
+  // 0 or 1 with no intercept leaves the voxels as stored. ITK rescales (and may change the voxel
+  // type) otherwise.
+  const auto finiteOrZero = [](float v) { return std::isfinite(v) ? v : 0.0f; };
+  const float slope = finiteOrZero(r.get<float>(112)), inter = finiteOrZero(r.get<float>(116));
+  if ((slope != 0 && slope != 1) || inter != 0) because("its voxels are scaled (scl_slope, scl_inter)");
 
   const float voxOffset = r.get<float>(108);
   if (!(voxOffset >= 0) || !std::isfinite(voxOffset))

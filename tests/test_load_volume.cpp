@@ -472,6 +472,30 @@ TEST(LoadVolume, ScaledNiftiIsDecodedByItk) {
   expectSame(loaded, io::readVolume(path), path);
 }
 
+/// scl_slope = 0 with an scl_inter: the NIfTI-1 header calls it unscaled, but ITK 5.2 reads the
+/// slope as 1 and adds the intercept (as it does for a NaN slope). Float voxels keep their type
+/// then, so a mapping of the stored values would differ from readVolume (found by fuzz/): the
+/// loader decodes them as ITK does, stored value + intercept.
+TEST(LoadVolume, NiftiSlopeZeroWithAnInterceptIsReadAsItkReadsIt) {
+  TempDir dir;
+  const DenseImage<float> image = makeVolume<float>(kDims);
+  for (const float slope : {0.0f, std::nanf("")}) {
+    const std::string path = dir / "slope0.nii";
+    io::writeVolume(io::AnyVolume(image), path);
+    std::string bytes = contents(path);
+    const float inter = 0.5f;
+    std::memcpy(&bytes[112], &slope, 4);
+    std::memcpy(&bytes[116], &inter, 4);
+    writeFile(path, bytes);
+    const LoadedVolume loaded = io::loadVolume(path);
+    EXPECT_FALSE(loaded.mapped) << slope;
+    expectSame(loaded, io::readVolume(path), path);
+    ASSERT_EQ(loaded.view.type, ScalarType::Float32);
+    const auto* v = static_cast<const float*>(loaded.view.data);
+    for (std::size_t i = 0; i < image.data().size(); ++i) ASSERT_EQ(v[i], image.data()[i] + inter) << i;
+  }
+}
+
 TEST(LoadVolume, NiftiFloatsWithNanAreDecodedAsReadVolumeReadsThem) {
   TempDir dir;
   for (const bool isDouble : {false, true}) {
