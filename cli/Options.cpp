@@ -266,6 +266,13 @@ InputArgs addInputOptions(CLI::App& app, InputOptions& in) {
       "the physical position of voxel (0,0,0), instead of the file's")
       ->check(tripleOf({kNumber}, "expected three numbers X,Y,Z"))
       ->group("geometry override");
+  app.add_option("--channel", in.channel,
+                 "the channel to read, from 0, of a multi-channel TIFF stack\n(ImageJ or OME-TIFF)")
+      ->option_text("C")
+      ->check(explained(CLI::Range(0, 1 << 30), [](const std::string& s) {
+        return "expected a channel number from 0, got '" + s + "'";
+      }))
+      ->group("input and output");
   return a;
 }
 

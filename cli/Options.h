@@ -33,6 +33,7 @@ struct InputOptions {
   io::RawLayout rawLayout;       ///< --raw-dims, --raw-type, --raw-endian, --raw-header
   std::optional<std::array<double, 3>> spacing;  ///< --spacing
   std::optional<std::array<double, 3>> origin;   ///< --origin
+  std::optional<int> channel;                    ///< --channel C: of a multi-channel TIFF stack
 };
 
 enum class SeedMode { Largest, All, Voxel, Ray, Surfel, Point };

@@ -134,8 +134,9 @@ LoadedVolume viewVoxels(const detail::OpenFile& file, std::uint64_t offset, Scal
 }
 
 /// ITK decodes the file once; the LoadedVolume views ITK's buffer.
-LoadedVolume decodedByItk(const std::string& path, std::string format, std::string reason) {
-  LoadedVolume out = detail::decodeWithItk(path);
+LoadedVolume decodedByItk(const std::string& path, std::string format, std::string reason,
+                          const ReadOptions& options = {}) {
+  LoadedVolume out = detail::decodeWithItk(path, options);
   if (!format.empty()) out.format = std::move(format);
   if (reason.empty())
     reason = out.format == "nii.gz" ? "it is gzip-compressed" : "ITK decodes " + out.format + " files";
@@ -233,9 +234,13 @@ void LoadedVolume::advise(Access access) const {
   if (mapped) detail::adviseAccess(view.data, dataBytes, access == Access::Sparse);
 }
 
-LoadedVolume loadVolume(const std::string& path) {
+LoadedVolume loadVolume(const std::string& path, const ReadOptions& options) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read " + quoted(path) + ": no such file");
+  const Format* format = formatOf(path);
+  if (!format && !hasSuffix(path, ".nii.gz")) return decodedByItk(path, "", "", options);
+  // (The formats read here, mapped or inflated or decoded, hold one channel.)
+  detail::requireChannel(path, options, 1, "");
   if (hasSuffix(path, ".nii.gz") && !fs::is_directory(path, ec)) {
     try {
       return loadGzippedNifti(path);
@@ -243,7 +248,6 @@ LoadedVolume loadVolume(const std::string& path) {
       throw ReadError("cannot read " + quoted(path) + ": out of memory");
     }
   }
-  const Format* format = formatOf(path);
   if (!format || fs::is_directory(path, ec)) return decodedByItk(path, "", "");
   try {
     const detail::OpenFile file(path, "cannot read " + quoted(path));

@@ -35,6 +35,9 @@
 #include <zlib.h>
 
 #include "Internal.h"
+#include "MappedFile.h"
+#include "TiffStack.h"
+#include "VolumeHeader.h"
 
 namespace surftrack::io {
 
@@ -198,6 +201,13 @@ std::string componentsText(unsigned components) {
   return "its voxels have " + std::to_string(components) + " components (RGB, complex or vector voxels)";
 }
 
+/// What readWithItk read besides the image: the format, and a TIFF stack's unit and channel.
+struct ItkRead {
+  std::string format;
+  std::string unit;
+  int channel = 0, channels = 1;
+};
+
 /// Reads the first DICOM series of a directory and hands the image to `use`.
 template <class Use>
 auto readDicomDirectory(const std::string& path, Use&& use) {
@@ -215,7 +225,9 @@ auto readDicomDirectory(const std::string& path, Use&& use) {
     throw unsupportedType(path, componentsText(dicom->GetNumberOfComponents()));
   const auto type = scalarTypeOf(dicom->GetComponentType());
   if (!type) throw unsupportedType(path, "its voxel type is '" + componentName(dicom->GetComponentType()) + "'");
-  return visitScalarType(*type, [&](auto v) { return use(readSeriesAs<decltype(v)>(files), std::string("dicom")); });
+  ItkRead read;
+  read.format = "dicom";
+  return visitScalarType(*type, [&](auto v) { return use(readSeriesAs<decltype(v)>(files), read); });
 }
 
 std::string lowerName(const std::string& path) {
@@ -422,21 +434,91 @@ std::string formatOf(const itk::ImageIOBase* imageIO, const std::string& path) {
   return ext.size() > 1 ? ext.substr(1) : io;
 }
 
+/// The ImageJ or OME metadata of the TIFF `path` (io/TiffStack.h).
+TiffStack tiffStackOf(const std::string& path) {
+  const detail::OpenFile file(path, "cannot read '" + path + "'");
+  try {
+    return parseTiffStack(
+        [&](std::uint64_t offset, std::size_t bytes) {
+          std::string out(bytes, '\0');
+          out.resize(file.readAt(offset, out.data(), bytes));
+          return out;
+        },
+        file.size(), fs::path(path).filename().string());
+  } catch (const HeaderError& e) {
+    throw ReadError("cannot read '" + path + "': " + e.what());
+  }
+}
+
+/// The slices of channel `channel` of a TIFF stack that ITK read as one volume of all its pages
+/// (a copy, unless the stack has one channel), with the voxel size its metadata states.
+template <class T>
+ImagePointer<T> stackChannel(const ImagePointer<T>& pages, const TiffStack& stack, int channel, const std::string& path) {
+  using Image = itk::Image<T, 3>;
+  const auto size = pages->GetLargestPossibleRegion().GetSize();
+  if (std::int64_t(size[2]) != stack.pages())
+    throw ReadError("cannot read '" + path + "': its " + stack.source + " metadata announces " +
+                    std::to_string(stack.pages()) + " images (" + std::to_string(stack.channels) + " channels x " +
+                    std::to_string(stack.slices) + " slices), and ITK reads " + std::to_string(size[2]) + " pages");
+  if (stack.width != 0 && (std::int64_t(size[0]) != stack.width || std::int64_t(size[1]) != stack.height))
+    throw ReadError("cannot read '" + path + "': its OME metadata announces " + std::to_string(stack.width) + " x " +
+                    std::to_string(stack.height) + " pixels a plane, and ITK reads " + std::to_string(size[0]) + " x " +
+                    std::to_string(size[1]));
+  ImagePointer<T> out = pages;
+  if (stack.channels > 1) {
+    out = Image::New();
+    typename Image::SizeType outSize = size;
+    outSize[2] = std::size_t(stack.slices);
+    out->SetRegions(typename Image::RegionType(outSize));
+    out->SetSpacing(pages->GetSpacing());
+    out->SetOrigin(pages->GetOrigin());
+    out->SetDirection(pages->GetDirection());
+    out->Allocate();
+    const std::size_t plane = size[0] * size[1];
+    for (std::int64_t z = 0; z < stack.slices; ++z) {
+      const std::int64_t page = stack.channelFirst ? channel + stack.channels * z : z + stack.slices * channel;
+      const T* from = pages->GetBufferPointer() + std::size_t(page) * plane;
+      std::copy(from, from + plane, out->GetBufferPointer() + std::size_t(z) * plane);
+    }
+  }
+  if (stack.spacing) {
+    typename Image::SpacingType spacing;
+    for (int a = 0; a < 3; ++a) spacing[a] = (*stack.spacing)[a];
+    out->SetSpacing(spacing);
+  }
+  return out;
+}
+
 /// Reads `path` with ITK (a file, or a directory holding a DICOM series) and hands the decoded
-/// image and its format to `use`; readVolume's checks, ITK's errors as ReadError.
+/// image and what else was read (ItkRead) to `use`; readVolume's checks, ITK's errors as
+/// ReadError.
 template <class Use>
-auto readWithItk(const std::string& path, Use&& use) {
+auto readWithItk(const std::string& path, const ReadOptions& options, Use&& use) {
   registerFactories();
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
   try {
-    if (fs::is_directory(path, ec)) return readDicomDirectory(path, use);
+    if (fs::is_directory(path, ec)) {
+      detail::requireChannel(path, options, 1, "");
+      return readDicomDirectory(path, use);
+    }
     ScalarType type{};
     std::size_t voxels = 0;
     itk::ImageIOBase::Pointer imageIO = openImageIO(path, type, voxels);
     requireCompleteData(imageIO, path, voxels);
-    const std::string format = formatOf(imageIO, path);
-    return visitScalarType(type, [&](auto v) { return use(readFileAs<decltype(v)>(imageIO, path), format); });
+    ItkRead read;
+    read.format = formatOf(imageIO, path);
+    TiffStack stack;
+    if (read.format == "tiff") stack = tiffStackOf(path);
+    read.unit = stack.unit;
+    read.channels = int(stack.channels);
+    read.channel = detail::requireChannel(path, options, stack.channels, stack.channelsField);
+    return visitScalarType(type, [&](auto v) {
+      using T = decltype(v);
+      ImagePointer<T> image = readFileAs<T>(imageIO, path);
+      if (!stack.source.empty()) image = stackChannel<T>(image, stack, read.channel, path);
+      return use(image, read);
+    });
   } catch (const itk::ExceptionObject& e) {
     throw ReadError("cannot read '" + path + "': " + oneLine(e));
   } catch (const std::bad_alloc&) {
@@ -446,20 +528,38 @@ auto readWithItk(const std::string& path, Use&& use) {
 
 }  // namespace
 
-AnyVolume readVolume(const std::string& path) {
-  return readWithItk(path, [&](auto image, const std::string&) -> AnyVolume {
+AnyVolume readVolume(const std::string& path, const ReadOptions& options) {
+  return readWithItk(path, options, [&](auto image, const ItkRead&) -> AnyVolume {
     return toDense(image.GetPointer(), path);
   });
 }
 
 namespace detail {
 
-LoadedVolume decodeWithItk(const std::string& path) {
-  return readWithItk(path, [&](auto image, const std::string& format) -> LoadedVolume {
+LoadedVolume decodeWithItk(const std::string& path, const ReadOptions& options) {
+  return readWithItk(path, options, [&](auto image, const ItkRead& read) -> LoadedVolume {
     LoadedVolume out = toLoaded(image, path);
-    out.format = format;
+    out.format = read.format;
+    out.unit = read.unit;
+    out.channel = read.channel;
+    out.channels = read.channels;
     return out;
   });
+}
+
+int requireChannel(const std::string& path, const ReadOptions& options, std::int64_t channels, const std::string& field) {
+  const std::string last = std::to_string(channels - 1);
+  if (!options.channel) {
+    if (channels == 1) return 0;
+    throw ReadError("cannot read '" + path + "': it has " + std::to_string(channels) + " channels (" + field +
+                    "); choose one with --channel C, C from 0 to " + last);
+  }
+  const int c = *options.channel;
+  if (c < 0 || c >= channels)
+    throw ReadError("cannot read '" + path + "': there is no channel " + std::to_string(c) + " (--channel): " +
+                    (channels == 1 ? std::string("it has one channel, 0")
+                                   : "it has " + std::to_string(channels) + " channels (" + field + "), 0 to " + last));
+  return c;
 }
 
 ItkHeader readItkHeader(const std::string& path) {
