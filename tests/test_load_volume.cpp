@@ -1113,6 +1113,73 @@ TEST(LoadVolume, EveryCutOfAHeaderIsAHeaderErrorOrMoreBytes) {
   }
 }
 
+#ifdef SURFTRACK_FUZZ_DIR
+/// The fuzzers' corpus and kept findings (fuzz/corpus/<format>/, fuzz/findings/<format>/, of
+/// fuzz/run_fuzzers.sh), replayed as fuzz/fuzz_volume_header.cpp runs them, through this build:
+/// each input is a ReadError or a volume whose every voxel reads, with the type, dimensions
+/// and geometry of readVolume, and its voxels unless ITK decoded them (a finding once crashed,
+/// hung or made the two disagree; a hang would stop this test).
+TEST(LoadVolume, FuzzCorpusAndFindingsReplay) {
+  TempDir dir;
+  std::string pattern(65536, '\0');  // the fuzz target's data file next to each input
+  for (std::size_t i = 0; i < pattern.size(); ++i) pattern[i] = char(i * 131 + (i >> 8));
+  writeFile(dir / "data.raw", pattern);
+  int replayed = 0, findings = 0;
+  for (const std::string kind : {"corpus", "findings"}) {
+    const fs::path root = fs::path(SURFTRACK_FUZZ_DIR) / kind;
+    if (!fs::is_directory(root)) continue;
+    for (const auto& formatDir : fs::directory_iterator(root)) {
+      const std::string format = formatDir.path().filename().string();
+      for (const auto& entry : fs::directory_iterator(formatDir.path())) {
+        const std::string bytes = contents(entry.path().string());
+        SCOPED_TRACE(entry.path().string());
+        const std::string input = dir / ("input." + format);
+        io::ReadOptions options;
+        std::function<LoadedVolume()> load;
+        std::function<io::AnyVolume()> read;
+        if (format == "raw") {  // the layout from the first 5 bytes (fuzzRaw)
+          if (bytes.size() < 5) continue;
+          io::RawLayout layout;
+          const auto b = [&](int i) { return static_cast<unsigned char>(bytes[std::size_t(i)]); };
+          layout.type = ScalarType(b(0) % 10);
+          layout.bigEndian = b(0) & 0x80;
+          layout.headerBytes = b(1) % 32;
+          layout.dims = {1 + b(2) % 16, 1 + b(3) % 16, 1 + b(4) % 16};
+          writeFile(input, bytes.substr(5));
+          load = [=] { return io::loadRawVolume(input, layout); };
+          read = [=] { return io::readRawVolume(input, layout); };
+        } else {
+          if (format == "tif" && bytes.size() % 3 != 0) options.channel = int(bytes.size() % 3) - 1;
+          writeFile(input, bytes);
+          load = [=] { return io::loadVolume(input, options); };
+          read = [=] { return io::readVolume(input, options); };
+        }
+        ++replayed;
+        findings += kind == "findings";
+        LoadedVolume loaded;
+        try {
+          loaded = load();
+        } catch (const io::ReadError& e) {
+          EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+          continue;
+        }
+        const io::AnyVolume volume = read();
+        const bool decoded = loaded.decodeReason.find("(decoded by ITK)") != std::string::npos;
+        if (!decoded) {
+          expectSame(loaded, volume, entry.path().string());
+          continue;
+        }
+        ASSERT_EQ(loaded.view.type, io::scalarTypeOf(volume));
+        ASSERT_EQ(loaded.view.dims, io::dimsOf(volume));
+        for (int i = 0; i < 3; ++i) EXPECT_NEAR(loaded.view.geometry.spacing[i], io::geometryOf(volume).spacing[i], 1e-9);
+      }
+    }
+  }
+  EXPECT_GT(findings, 0) << SURFTRACK_FUZZ_DIR "/findings holds no finding";
+  std::printf("[          ] %d inputs replayed, %d of them kept findings\n", replayed, findings);
+}
+#endif
+
 /// Random damage to the headers of valid files: a ReadError or a volume whose every voxel can be
 /// read, never a crash (the fuzzer, fuzz/, does this at scale).
 TEST(LoadVolume, DamagedHeadersNeverCrash) {
