@@ -58,8 +58,13 @@ void describeInput(const io::LoadedVolume& volume, const std::string& path, Extr
 }
 
 io::LoadedVolume readInput(const InputOptions& input) {
+  io::ReadOptions options;
+  options.channel = input.channel;
   io::LoadedVolume volume = input.raw ? io::loadRawVolume(input.path, input.rawLayout)
-                                      : io::loadVolume(input.path);
+                                      : io::loadVolume(input.path, options);
+  if (input.raw && input.channel && *input.channel != 0)
+    throw io::ReadError("cannot read '" + input.path + "': there is no channel " + std::to_string(*input.channel) +
+                        " (--channel): a raw file has one channel, 0");
   ImageGeometry& g = volume.view.geometry;
   if (input.ras) {
     // RAS = diag(-1, -1, 1) LPS: the origin and the direction's x and y rows negated. The

@@ -291,6 +291,13 @@ InputArgs addInputOptions(CLI::App& app, InputOptions& in) {
       ->check(explained(CLI::IsMember({"lps", "ras", "LPS", "RAS"}),
                         [](const std::string& s) { return "expected lps or ras, got '" + s + "'"; }))
       ->group("geometry override");
+  app.add_option("--channel", in.channel,
+                 "the channel to read, from 0, of a multi-channel TIFF stack\n(ImageJ or OME-TIFF)")
+      ->option_text("C")
+      ->check(explained(CLI::Range(0, 1 << 30), [](const std::string& s) {
+        return "expected a channel number from 0, got '" + s + "'";
+      }))
+      ->group("input and output");
   return a;
 }
 

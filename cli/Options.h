@@ -35,6 +35,7 @@ struct InputOptions {
   std::optional<std::array<double, 3>> spacing;  ///< --spacing
   std::optional<std::array<double, 3>> origin;   ///< --origin
   bool ras = false;  ///< --frame ras: physical coordinates in RAS (nibabel, MNI), not ITK's LPS
+  std::optional<int> channel;                    ///< --channel C: of a multi-channel TIFF stack
 };
 
 enum class SeedMode { Largest, All, Voxel, Ray, Surfel, Point };

@@ -387,9 +387,11 @@ void printVolumeInfo(std::ostream& out, const std::string& path, const io::Loade
   out << "surftrack: " << path << "\n";
   row(out, "size", std::to_string(d.nx) + " x " + std::to_string(d.ny) + " x " + std::to_string(d.nz) +
                        " = " + std::to_string(d.count()) + " voxels of " + io::toString(volume.view.type));
-  row(out, "spacing", tripleText(g.spacing));
+  row(out, "spacing", tripleText(g.spacing) + (volume.unit.empty() ? "" : " " + volume.unit));
   row(out, "origin", tripleText(g.origin) + " (" + volume.frame + " frame)");
   row(out, "direction", directionText(g));
+  if (volume.channels > 1)
+    row(out, "channel", std::to_string(volume.channel) + " of channels 0 to " + std::to_string(volume.channels - 1));
   std::array<double, 3> far = g.toPhysical({double(d.nx - 1), double(d.ny - 1), double(d.nz - 1)});
   row(out, "extent", "voxel centres from " + tripleText(g.origin) + " to " + tripleText(far));
   row(out, "storage", storageText(volume));
@@ -432,8 +434,11 @@ json volumeJson(const std::string& path, const io::LoadedVolume& volume, const V
   j["dims"] = {d.nx, d.ny, d.nz};
   j["type"] = io::toString(volume.view.type);
   j["spacing"] = numbers(g.spacing);
+  if (!volume.unit.empty()) j["unit"] = volume.unit;
   j["origin"] = numbers(g.origin);
   j["direction"] = directionJson(g);
+  j["channel"] = volume.channel;
+  j["channels"] = volume.channels;
   j["storage"] = storageJson(volume);
   j["min"] = number(s.min);
   j["max"] = number(s.max);

@@ -1,11 +1,11 @@
 // libFuzzer target: arbitrary bytes as a volume file of one format, "mha", "mhd", "nrrd",
-// "nhdr", "nii", "nii.gz" or "raw", named by the program's name: fuzz_volume_header_<format> (one binary,
-// one link to it per format, fuzz/CMakeLists.txt).
+// "nhdr", "nii", "nii.gz", "raw" or "tif", named by the program's name:
+// fuzz_volume_header_<format> (one binary, one link to it per format, fuzz/CMakeLists.txt).
 //
 // Each input goes through
-//  1. the format's header parser (io/VolumeHeader.h) on the input buffer itself, whole and cut
-//     in half: libFuzzer's buffer is exactly the input, so AddressSanitizer reports any read
-//     past it;
+//  1. the format's header parser (io/VolumeHeader.h; io/TiffStack.h for tif) on the input
+//     buffer itself, whole and cut in half: libFuzzer's buffer is exactly the input, so
+//     AddressSanitizer reports any read past it;
 //  2. the whole loader on a file holding the input (loadVolume, or loadRawVolume with a layout
 //     taken from the input's first bytes), every voxel of the result read (a read past a
 //     mapping is a SIGSEGV or SIGBUS: a crash);
@@ -27,6 +27,7 @@
 
 #include "LoadVolume.h"
 #include "ReadVolume.h"
+#include "TiffStack.h"
 #include "VolumeHeader.h"
 
 namespace {
@@ -81,9 +82,33 @@ void requireSame(const io::LoadedVolume& loaded, const io::AnyVolume& read) {
   std::visit([&](const auto& image) {
     const std::size_t size = sizeOf(loaded.view.type);
     const auto* p = static_cast<const unsigned char*>(loaded.view.data);
-    if (std::memcmp(p, image.data().data(), image.data().size() * size) != 0)
-      fail("loadVolume and readVolume disagree on the voxels");
+    for (std::size_t i = 0; i < image.data().size(); ++i)
+      if (std::memcmp(p + i * size, &image.data()[i], size) != 0) {
+        double a = 0;
+        visitScalarType(loaded.view.type, [&](auto t) {
+          decltype(t) v;
+          std::memcpy(&v, p + i * size, size);
+          a = double(v);
+        });
+        fail("loadVolume and readVolume disagree on voxel " + std::to_string(i) + ": " + std::to_string(a) + " (" +
+             std::to_string(a == 0 ? 0 : std::log10(std::abs(a))) + " decades) against " +
+             std::to_string(double(image.data()[i])) + " (" + loaded.decodeReason + ")");
+      }
   }, read);
+}
+
+/// The TIFF metadata parser (io/TiffStack.h) on the input buffer itself, whole.
+void parseTiffBuffer(std::string_view bytes) {
+  try {
+    const io::TiffStack stack = io::parseTiffStack(
+        [&](std::uint64_t offset, std::size_t n) {
+          return offset >= bytes.size() ? std::string() : std::string(bytes.substr(std::size_t(offset), n));
+        },
+        bytes.size(), "input.tif");
+    if (stack.channels < 1 || stack.slices < 1 || stack.pages() > (std::int64_t(1) << 31))
+      fail("the TIFF parser gives an impossible stack");
+  } catch (const io::HeaderError&) {
+  }
 }
 
 void parseBuffer(std::string_view bytes) {
@@ -127,19 +152,25 @@ void fuzzRaw(const uint8_t* data, size_t size) {
 }
 
 void fuzzFile(const uint8_t* data, size_t size) {
-  if (gFormat != "nii.gz")  // (gzip'd bytes: the parser sees them inflated, through the loader)
-    parseBuffer(std::string_view(reinterpret_cast<const char*>(data), size));
+  const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+  if (gFormat == "tif")
+    parseTiffBuffer(bytes);
+  else if (gFormat != "nii.gz")  // (gzip'd bytes: the parser sees them inflated, through the loader)
+    parseBuffer(bytes);
   writeInput(data, size);
+  // A TIFF stack's channel: none, 0 or 1, by the input's length.
+  io::ReadOptions options;
+  if (gFormat == "tif" && size % 3 != 0) options.channel = int(size % 3) - 1;
   io::LoadedVolume loaded;
   try {
-    loaded = io::loadVolume(gInput);
+    loaded = io::loadVolume(gInput, options);
   } catch (const io::ReadError&) {
     return;
   }
   touchAll(loaded.view);
   io::AnyVolume read;
   try {
-    read = io::readVolume(gInput);
+    read = io::readVolume(gInput, options);
   } catch (const io::ReadError& e) {
     fail(std::string("loadVolume accepts what readVolume rejects: ") + e.what());
   }
@@ -153,8 +184,9 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   const std::string prefix = "fuzz_volume_header_";
   gFormat = name.rfind(prefix, 0) == 0 ? name.substr(prefix.size()) : "";
   if (gFormat != "mha" && gFormat != "mhd" && gFormat != "nrrd" && gFormat != "nhdr" && gFormat != "nii" &&
-      gFormat != "nii.gz" && gFormat != "raw")
-    fail("run me as fuzz_volume_header_<format>, format mha, mhd, nrrd, nhdr, nii, nii.gz or raw (not '" + name + "')");
+      gFormat != "nii.gz" && gFormat != "raw" && gFormat != "tif")
+    fail("run me as fuzz_volume_header_<format>, format mha, mhd, nrrd, nhdr, nii, nii.gz, raw or tif (not '" + name +
+         "')");
   // One directory per process (libFuzzer's -jobs/-workers run several): under /dev/shm when
   // there is one, so that the inputs never reach a disk.
   const fs::path base = fs::exists("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();

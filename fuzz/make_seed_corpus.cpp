@@ -1,10 +1,12 @@
 // Writes the seed corpus of fuzz/fuzz_volume_header.cpp: small valid files of every format,
 // written by ITK (io::writeVolume) where ITK writes them and by hand for what it does not
-// (big-endian voxels, byte skips, HeaderSize), in <dir>/<format>/ for the formats mha, mhd,
-// nrrd, nhdr, nii, nii.gz and raw. Detached headers are rewritten to name "data.raw", the data file
-// the fuzz target puts next to each input. Usage: make_seed_corpus <dir>
+// (big-endian voxels, byte skips, HeaderSize, TIFF stacks with ImageJ and OME metadata), in
+// <dir>/<format>/ for the formats mha, mhd, nrrd, nhdr, nii, nii.gz, raw and tif. Detached
+// headers are rewritten to name "data.raw", the data file the fuzz target puts next to each
+// input. Usage: make_seed_corpus <dir>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -61,6 +63,62 @@ void written(const io::AnyVolume& v, const std::string& ext, const std::string& 
   put(ext, tag + (compress ? "-compressed" : "") + "." + ext, bytes);
 }
 
+/// A classic little-endian TIFF of `pages` pages of w x h uint8 voxels (value: page + 1), the
+/// first page with `description` (ImageDescription) and an XResolution and YResolution of 10
+/// pixels per unit: what ImageJ and OME writers write, in a form ITK does not.
+std::string tiff(int pages, int w, int h, const std::string& description) {
+  std::string out = "II*";
+  out += '\0';
+  auto u16 = [&](std::string& s, unsigned v) { s += char(v & 0xff); s += char(v >> 8); };
+  auto u32 = [&](std::string& s, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) s += char((v >> (8 * i)) & 0xff);
+  };
+  u32(out, 8);
+  for (int p = 0; p < pages; ++p) {
+    const bool first = p == 0;
+    const int tags = first ? 12 : 9;
+    const std::uint32_t ifd = std::uint32_t(out.size());
+    const std::uint32_t extra = ifd + 2 + 12 * std::uint32_t(tags) + 4;  // description, rationals, voxels
+    const std::uint32_t descriptionAt = extra, rationalsAt = descriptionAt + std::uint32_t(description.size() + 1);
+    const std::uint32_t voxelsAt = first ? rationalsAt + 16 : extra;
+    std::string d;
+    u16(d, unsigned(tags));
+    auto tag = [&](unsigned id, unsigned type, std::uint32_t count, std::uint32_t value) {
+      u16(d, id);
+      u16(d, type);
+      u32(d, count);
+      u32(d, value);
+    };
+    tag(256, 4, 1, std::uint32_t(w));
+    tag(257, 4, 1, std::uint32_t(h));
+    tag(258, 3, 1, 8);
+    tag(259, 3, 1, 1);
+    tag(262, 3, 1, 1);
+    if (first) tag(270, 2, std::uint32_t(description.size() + 1), descriptionAt);
+    tag(273, 4, 1, voxelsAt);
+    tag(277, 3, 1, 1);
+    tag(278, 4, 1, std::uint32_t(h));
+    tag(279, 4, 1, std::uint32_t(w * h));
+    if (first) {
+      tag(282, 5, 1, rationalsAt);
+      tag(283, 5, 1, rationalsAt + 8);
+    }
+    const std::uint32_t next = voxelsAt + std::uint32_t(w * h);
+    u32(d, p + 1 < pages ? next : 0);
+    if (first) {
+      d += description;
+      d += '\0';
+      for (int r = 0; r < 2; ++r) {
+        u32(d, 10);
+        u32(d, 1);
+      }
+    }
+    d += std::string(std::size_t(w * h), char(p + 1));
+    out += d;
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -103,6 +161,29 @@ int main(int argc, char** argv) {
   put("mhd", "numbered.mhd", metaStart + "ElementType = MET_SHORT\nElementDataFile = dat%d.raw 1 2 1\n");
   put("mhd", "list.mhd", metaStart + "ElementType = MET_SHORT\nElementDataFile = LIST\ndata.raw\ndata.raw\n");
   put("mhd", "channels.mhd", metaStart + "ElementNumberOfChannels = 2\nElementType = MET_SHORT\nElementDataFile = data.raw\n");
+  // TIFF: written by ITK (one page per slice), and by hand with ImageJ and OME metadata.
+  for (const io::AnyVolume& v : {volume<std::uint8_t>(), volume<std::int16_t>(), volume<float>()}) {
+    try {
+      written(v, "tif", toString(io::scalarTypeOf(v)), false);
+    } catch (const std::exception&) {  // (a type ITK's TIFF writer does not write)
+    }
+  }
+  put("tif", "imagej-c2.tif", tiff(6, 3, 4, "ImageJ=1.53t\nimages=6\nchannels=2\nslices=3\nhyperstack=true\nspacing=0.3\nunit=micron\n"));
+  put("tif", "imagej-stack.tif", tiff(3, 3, 4, "ImageJ=1.53t\nimages=3\nslices=3\nspacing=2.5\nunit=nm\n"));
+  put("tif", "imagej-frames.tif", tiff(4, 3, 4, "ImageJ=1.53t\nimages=4\nslices=2\nframes=2\n"));
+  const std::string ome =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?><OME xmlns=\"http://www.openmicroscopy.org/Schemas/OME/2016-06\">"
+      "<Image ID=\"Image:0\"><Pixels ID=\"Pixels:0\" DimensionOrder=\"XYZCT\" Type=\"uint8\" SizeX=\"3\" SizeY=\"4\" "
+      "SizeC=\"2\" SizeZ=\"3\" SizeT=\"1\" PhysicalSizeX=\"0.1\" PhysicalSizeY=\"0.1\" PhysicalSizeZ=\"300\" "
+      "PhysicalSizeZUnit=\"nm\"><Channel ID=\"Channel:0:0\" SamplesPerPixel=\"1\"/><Channel ID=\"Channel:0:1\" "
+      "SamplesPerPixel=\"1\"/>";
+  put("tif", "ome-c2.tif", tiff(6, 3, 4, ome + "<TiffData IFD=\"0\" PlaneCount=\"6\"/></Pixels></Image></OME>"));
+  std::string planes;
+  for (int c = 0; c < 2; ++c)
+    for (int z = 0; z < 3; ++z)
+      planes += "<TiffData FirstC=\"" + std::to_string(c) + "\" FirstZ=\"" + std::to_string(z) + "\" IFD=\"" +
+                std::to_string(z + 3 * c) + "\" PlaneCount=\"1\"><UUID FileName=\"input.tif\">urn:uuid:1</UUID></TiffData>";
+  put("tif", "ome-planes.tif", tiff(6, 3, 4, ome + planes + "</Pixels></Image></OME>"));
   // A float NIfTI with a NaN (which niftilib reads as 0).
   {
     DenseImage<float> image(Dims{3, 4, 2}, 1.5f, geometry());

@@ -1,17 +1,30 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of fuzz/ with clang in a build directory of their own, writes
-# their seed corpus and runs each target (mha, mhd, nrrd, nhdr, nii, raw; nii.gz on request) for a
-# bounded time.
+# their seed corpus, replays the kept findings and runs each target (mha, mhd, nrrd, nhdr, nii,
+# nii.gz, raw, tif) for a bounded time.
 #
 #   fuzz/run_fuzzers.sh [seconds per target, default 30] [build directory, default ./build-fuzz]
 #
+# Inputs, per format f:
+#   fuzz/corpus/f/    the corpus kept in the repository: inputs that reach code the generated
+#                     seeds do not, grown by exploratory runs (SURFTRACK_FUZZ_KEEP=1 below) and
+#                     minimised with libFuzzer's -merge=1; small files.
+#   fuzz/findings/f/  every input that once crashed, hung or made the readers disagree, kept
+#                     once fixed: replayed first, each must pass (tests/test_load_volume.cpp
+#                     replays them too, and the corpus, through the gcc build).
+#   <build>/corpus/f/ the seeds make_seed_corpus writes (fuzz/make_seed_corpus.cpp).
+#
 # With SURFTRACK_FUZZ_RUNS=N each target runs N inputs from a fixed seed (SURFTRACK_FUZZ_SEED,
 # default 1) instead of for a time: the same inputs on every machine, so that a finding is the
-# code's, not the luck of one run (CI runs this way; exploring is for runs by time).
+# code's, not the luck of one run (CI runs this way; exploring is for runs by time). With
+# SURFTRACK_FUZZ_FORMATS="nii tif" only those formats run. With SURFTRACK_FUZZ_KEEP=1 the
+# inputs of the run that add coverage are merged into fuzz/corpus/f (minimised again, the
+# corpus rewritten): run by time for a minute or two per format, then commit the corpus.
 #
 # Exit status: 0 no finding; 1 a crash, hang (> 10 s on one input), leak in surftrack code,
-# out-of-memory or sanitizer report (the reproducer is in <build>/runs/<format>/findings/,
-# replay it with <build>/fuzz_volume_header_<format> <file>); 77 skipped: no clang++ (or g++).
+# out-of-memory or sanitizer report, or a kept finding that fails again (the reproducer is in
+# <build>/runs/<format>/findings/, replay it with <build>/fuzz_volume_header_<format> <file>;
+# once fixed, keep it in fuzz/findings/<format>/); 77 skipped: no clang++ (or g++).
 # ctest-runnable with SKIP_RETURN_CODE 77 (tests/CMakeLists.txt registers it only with
 # -DSURFTRACK_FUZZ_TEST=ON). Needs clang (Debian: apt-get install clang) and ITK.
 set -euo pipefail
@@ -19,11 +32,7 @@ set -euo pipefail
 seconds=${1:-30}
 build=${2:-$PWD/build-fuzz}
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-# nii.gz is left out of the default list: ITK 5.2's NIfTI reader hangs on some headers with
-# finite geometry that the parser accepts (an sform with offsets of 5e7 beside values of 1e-38,
-# found by that target in 30 s; the same header as a .nii hangs too), so a bounded run would
-# report ITK's hang, not one of ours. Run it by name: SURFTRACK_FUZZ_FORMATS="nii.gz".
-formats=(${SURFTRACK_FUZZ_FORMATS:-mha mhd nrrd nhdr nii raw})
+formats=(${SURFTRACK_FUZZ_FORMATS:-mha mhd nrrd nhdr nii nii.gz raw tif})
 
 for tool in clang++ clang g++; do
   if ! command -v "$tool" >/dev/null; then
@@ -46,22 +55,36 @@ echo "run_fuzzers: built in $((built - start)) s; $per per target"
 export LSAN_OPTIONS="suppressions=$here/lsan.supp:print_suppressions=0"
 export ASAN_OPTIONS="abort_on_error=1:detect_leaks=1:allocator_may_return_null=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+limits=(-timeout=10 -rss_limit_mb=2048)
 status=0
 for f in "${formats[@]}"; do
+  target="$build/fuzz_volume_header_$f"
   run="$build/runs/$f"
   rm -rf "$run"
   mkdir -p "$run/corpus" "$run/findings"
-  # A fresh corpus each run, grown from the seeds (kept in $run/corpus for inspection).
+  # The kept findings, each run once.
+  kept=("$here/findings/$f"/*)
+  if [[ -e ${kept[0]} ]] &&
+     ! "$target" "${kept[@]}" "${limits[@]}" -artifact_prefix="$run/findings/" </dev/null >"$run/replay.log" 2>&1; then
+    echo "run_fuzzers: $f: a kept finding fails again (fuzz/findings/$f/):"
+    grep -m3 -E "Running:|ERROR|SUMMARY|fuzz_volume_header \(" "$run/replay.log" || tail -5 "$run/replay.log"
+    status=1
+    continue
+  fi
+  # A fresh corpus each run (kept in $run/corpus for inspection), grown from the seeds and the
+  # repository's corpus.
+  seeds=("$build/corpus/$f")
+  [[ -d $here/corpus/$f ]] && seeds+=("$here/corpus/$f")
   if [[ -n ${SURFTRACK_FUZZ_RUNS:-} ]]; then
     budget=(-runs="$SURFTRACK_FUZZ_RUNS" -seed="${SURFTRACK_FUZZ_SEED:-1}")
   else
     budget=(-max_total_time="$seconds")
   fi
-  if "$build/fuzz_volume_header_$f" "$run/corpus" "$build/corpus/$f" "${budget[@]}" -timeout=10 \
-       -rss_limit_mb=2048 -artifact_prefix="$run/findings/" -print_final_stats=1 </dev/null >"$run/log" 2>&1; then
+  if "$target" "$run/corpus" "${seeds[@]}" "${budget[@]}" "${limits[@]}" \
+       -artifact_prefix="$run/findings/" -print_final_stats=1 </dev/null >"$run/log" 2>&1; then
     result=ok
   elif [[ -n $(ls "$run/findings") ]]; then
-    result="FINDING: $(ls "$run/findings" | head -1)"
+    result="FINDING: $run/findings/$(ls "$run/findings" | head -1)"
     status=1
   else
     result="stopped without a finding: $(grep -m1 -E 'interrupted|ERROR' "$run/log" || echo 'see the log')"
@@ -69,8 +92,22 @@ for f in "${formats[@]}"; do
   fi
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$run/log")
   cov=$(grep -o 'cov: [0-9]*' "$run/log" | tail -1)
-  echo "run_fuzzers: $f: ${runs:-?} inputs, $cov, corpus $(ls "$run/corpus" | wc -l) files: $result"
+  echo "run_fuzzers: $f: ${runs:-?} inputs, $cov, corpus $(ls "$run/corpus" | wc -l) files, ${#kept[@]} kept findings replayed: $result"
   [[ $result == ok ]] || grep -m3 -E "ERROR|SUMMARY|fuzz_volume_header \(" "$run/log" || true
+  # The repository's corpus and the run's inputs, minimised together: -merge=1 adds to a copy
+  # of the generated seeds the fewest inputs that reach what the seeds do not; those (named by
+  # their SHA-1) become fuzz/corpus/f.
+  if [[ ${SURFTRACK_FUZZ_KEEP:-} == 1 && $result == ok ]]; then
+    merged="$run/merged"
+    mkdir -p "$merged" "$here/corpus/$f"
+    cp "$build/corpus/$f"/* "$merged"/
+    "$target" -merge=1 "$merged" "$here/corpus/$f" "$run/corpus" "${limits[@]}" </dev/null >"$run/merge.log" 2>&1
+    for seed in "$build/corpus/$f"/*; do rm -f "$merged/$(basename "$seed")"; done
+    before=$(ls "$here/corpus/$f" | wc -l)
+    rm -f "$here/corpus/$f"/*
+    cp "$merged"/* "$here/corpus/$f"/ 2>/dev/null || true
+    echo "run_fuzzers: $f: fuzz/corpus/$f: $before -> $(ls "$here/corpus/$f" | wc -l) files ($(du -sk "$here/corpus/$f" | cut -f1) KiB)"
+  fi
 done
 echo "run_fuzzers: $(( $(date +%s) - start )) s in all"
 exit $status

@@ -33,6 +33,24 @@ inline bool equalsIgnoringCase(std::string_view a, std::string_view b) {
   return true;
 }
 
+/// One line of a header: the bytes of `s` from `pos` up to its '\n' (not included), and where
+/// the next line begins — after that '\n', or at s.size() when the line runs to the end of `s`
+/// without one. A cursor moved only by `next` never passes the end of `s`, so that every
+/// substr and index that follows stays inside it.
+struct Line {
+  std::string_view text;
+  std::size_t next = 0;
+  bool ended = false;  ///< the line has its '\n'
+};
+
+/// The line of `s` that begins at `pos` (a `pos` past the end gives an empty line at the end).
+inline Line lineAt(std::string_view s, std::size_t pos) {
+  if (pos > s.size()) pos = s.size();
+  const std::size_t eol = s.find('\n', pos);
+  if (eol == std::string_view::npos) return {s.substr(pos), s.size(), false};
+  return {s.substr(pos, eol - pos), eol + 1, true};
+}
+
 /// Words separated by blanks.
 inline std::vector<std::string_view> words(std::string_view s) {
   std::vector<std::string_view> out;

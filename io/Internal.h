@@ -25,9 +25,15 @@ struct ItkHeader {
 ItkHeader readItkHeader(const std::string& path);
 
 /// Reads `path` (a file or a directory holding a DICOM series) with ITK once, as readVolume
-/// does, and views ITK's own buffer: `owner` keeps the itk::Image alive, nothing is copied.
-/// `format` is filled in from the file name or the ImageIO ("dicom", "tiff", "vtk", ...).
-LoadedVolume decodeWithItk(const std::string& path);
+/// does, and views ITK's own buffer: `owner` keeps the itk::Image alive, nothing is copied (but
+/// the chosen channel of a multi-channel TIFF stack, copied out of it). `format` is filled in
+/// from the file name or the ImageIO ("dicom", "tiff", "vtk", ...), and `unit`, `channel` and
+/// `channels` from a TIFF's ImageJ or OME metadata.
+LoadedVolume decodeWithItk(const std::string& path, const ReadOptions& options);
+
+/// ReadError unless `options` chooses a channel the file has (`channels` of them, named by
+/// `field` when more than one) or, with one channel, none. The channel to read.
+int requireChannel(const std::string& path, const ReadOptions& options, std::int64_t channels, const std::string& field);
 
 /// The checks of readRawVolume on a raw file of `fileSize` bytes: positive dimensions and
 /// spacing, and exactly headerBytes + voxel bytes in the file. Throws ReadError.

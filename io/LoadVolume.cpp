@@ -136,8 +136,9 @@ LoadedVolume viewVoxels(const detail::OpenFile& file, std::uint64_t offset, Scal
 }
 
 /// ITK decodes the file once; the LoadedVolume views ITK's buffer.
-LoadedVolume decodedByItk(const std::string& path, std::string format, std::string reason) {
-  LoadedVolume out = detail::decodeWithItk(path);
+LoadedVolume decodedByItk(const std::string& path, std::string format, std::string reason,
+                          const ReadOptions& options = {}) {
+  LoadedVolume out = detail::decodeWithItk(path, options);
   if (!format.empty()) out.format = std::move(format);
   if (reason.empty())
     reason = out.format == "nii.gz" ? "it is gzip-compressed" : "ITK decodes " + out.format + " files";
@@ -287,18 +288,22 @@ std::optional<std::string> formsWarning(const std::string& path, const ImageGeom
 
 }  // namespace
 
-static LoadedVolume loadFile(const std::string& path);
+static LoadedVolume loadFile(const std::string& path, const ReadOptions& options);
 
-LoadedVolume loadVolume(const std::string& path) {
-  LoadedVolume out = loadFile(path);
+LoadedVolume loadVolume(const std::string& path, const ReadOptions& options) {
+  LoadedVolume out = loadFile(path, options);
   if (hasSuffix(path, ".nii") || hasSuffix(path, ".nii.gz"))
     if (auto w = formsWarning(path, out.view.geometry)) out.warnings.push_back(std::move(*w));
   return out;
 }
 
-static LoadedVolume loadFile(const std::string& path) {
+static LoadedVolume loadFile(const std::string& path, const ReadOptions& options) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read " + quoted(path) + ": no such file");
+  const Format* format = formatOf(path);
+  if (!format && !hasSuffix(path, ".nii.gz")) return decodedByItk(path, "", "", options);
+  // (The formats read here, mapped or inflated or decoded, hold one channel.)
+  detail::requireChannel(path, options, 1, "");
   if (hasSuffix(path, ".nii.gz") && !fs::is_directory(path, ec)) {
     try {
       return loadGzippedNifti(path);
@@ -306,7 +311,6 @@ static LoadedVolume loadFile(const std::string& path) {
       throw ReadError("cannot read " + quoted(path) + ": out of memory");
     }
   }
-  const Format* format = formatOf(path);
   if (!format || fs::is_directory(path, ec)) return decodedByItk(path, "", "");
   try {
     const detail::OpenFile file(path, "cannot read " + quoted(path));

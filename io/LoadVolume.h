@@ -42,6 +42,12 @@ struct LoadedVolume {
   std::shared_ptr<const void> owner;  ///< the mapping, or the decoded buffer (owner.get() == view.data)
   bool mapped = false;                ///< true: the file is memory-mapped, pages are read on demand
   std::string format;  ///< "raw", "mha", "mhd", "nrrd", "nhdr", "nii", "nii.gz", "dicom", "tiff", "vtk", ...
+  /// The unit of the spacing when the file states one that is not its format's own: "µm", "nm",
+  /// ... from a TIFF's ImageJ or OME metadata; empty otherwise (NIfTI, NRRD, MetaImage, DICOM:
+  /// millimetres, as ITK reads them).
+  std::string unit;
+  int channel = 0;   ///< the channel viewed, of
+  int channels = 1;  ///< the channels of a multi-channel TIFF stack (ReadOptions::channel)
   std::uintmax_t dataBytes = 0;  ///< bytes of voxel data (nx ny nz sizeof(type); decompressed size if compressed)
   /// Why the voxels were decoded or read rather than mapped in place (empty when mapped):
   /// "its voxels are gzip-encoded", "its voxels at byte 301 are not aligned to their 2-byte
@@ -75,11 +81,12 @@ struct LoadedVolume {
 
 /// Loads a volume, the format from the file name: .mha, .mhd, .nrrd, .nhdr and .nii are
 /// mapped when they can be (their headers read by this library's own strict parsers, their
-/// geometry by ITK), .nii.gz inflated by libdeflate when it can be, anything else ITK reads (see readVolume), including a directory holding
+/// geometry by ITK), .nii.gz inflated by libdeflate when it can be, anything else ITK reads (see
+/// readVolume: a multi-channel TIFF stack needs options.channel), including a directory holding
 /// one DICOM series. Throws ReadError with one line naming the file: missing, unreadable,
 /// malformed header, a file shorter than its header announces ("truncated file?"), unsupported
 /// voxel type.
-LoadedVolume loadVolume(const std::string& path);
+LoadedVolume loadVolume(const std::string& path, const ReadOptions& options = {});
 
 /// Loads a headerless raw file (see RawLayout). The file must hold exactly headerBytes +
 /// nx ny nz sizeof(type) bytes. Mapped when its voxels are little-endian (or one byte each) and

@@ -55,11 +55,10 @@ class Parser {
         if (first) throw HeaderError("not a MetaImage file: it is empty or blank");
         throw HeaderError("the MetaImage header ends before its ElementDataFile line (truncated file?)");
       }
-      const std::size_t eol = head_.find('\n', pos);
-      if (eol == std::string_view::npos && !whole) return std::nullopt;
-      const std::size_t end = eol == std::string_view::npos ? head_.size() : eol;
-      const std::size_t next = eol == std::string_view::npos ? head_.size() : eol + 1;
-      line_ = head_.substr(pos, end - pos);
+      const text::Line line = text::lineAt(head_, pos);
+      if (!line.ended && !whole) return std::nullopt;
+      const std::size_t next = line.next;
+      line_ = line.text;
       lineStart_ = pos;
       for (std::size_t i = 0; i < line_.size(); ++i)
         if (text::isControl(line_[i]) || (line_[i] == '\r' && i + 1 != line_.size()))
@@ -68,7 +67,7 @@ class Parser {
       if (sep == std::string_view::npos) {
         // The last line of the file, cut short (of the first line, a part of "ObjectType").
         const std::string_view cut = trim(line_);
-        if (eol == std::string_view::npos && (!first || std::string_view("ObjectType").substr(0, cut.size()) == cut))
+        if (!line.ended && (!first || std::string_view("ObjectType").substr(0, cut.size()) == cut))
           throw HeaderError("the MetaImage header ends within a line (truncated file?)");
         if (first) throw HeaderError("not a MetaImage file: it does not begin with 'ObjectType = Image'");
         fail("is not 'Key = Value'");
@@ -215,10 +214,10 @@ class Parser {
     listed_.clear();
     std::size_t pos = start;
     for (std::int64_t i = 0; i < files; ++i) {
-      const std::size_t eol = head_.find('\n', pos);
-      if (eol == std::string_view::npos && !whole) return false;
-      const std::size_t end = eol == std::string_view::npos ? head_.size() : eol;
-      std::string_view name = head_.substr(pos, end - pos);
+      // (The last name may end the file without its '\n': MetaIO's getline reads it.)
+      const text::Line line = text::lineAt(head_, pos);
+      if (!line.ended && !whole) return false;
+      std::string_view name = line.text;
       if (!name.empty() && name.back() == '\r') name.remove_suffix(1);
       if (pos >= head_.size() || trim(name).empty())
         fail("lists " + std::to_string(i) + " data files, and the image needs " + std::to_string(files));
@@ -226,7 +225,7 @@ class Parser {
       for (char c : name)
         if (text::isControl(c)) fail("lists a data file name with a control character");
       listed_.emplace_back(name);
-      pos = end + 1;
+      pos = line.next;
     }
     return true;
   }

@@ -3,14 +3,17 @@
 // byte vox_offset of the same file. Fields read here: sizeof_hdr (0), dim[8] (40), datatype
 // (70), vox_offset (108), scl_slope (112), scl_inter (116), magic (344); the geometry (pixdim
 // at 76, qform_code 252, sform_code 254, quatern_b..qoffset_z 256, srow_x..z 280) is ITK's to
-// read, and only checked to be finite here.
+// read, and only checked here: finite, and an sform ITK's reader can take (sformTrouble).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <optional>
 #include <utility>
 #include <vector>
 
 #include "HeaderText.h"
+#include "ReadVolume.h"
 #include "VolumeHeader.h"
 
 namespace surftrack::io {
@@ -33,6 +36,94 @@ std::optional<ScalarType> niftiType(int datatype) {
     case 16: return ScalarType::Float32;   // DT_FLOAT32
     case 64: return ScalarType::Float64;   // DT_FLOAT64
     default: return std::nullopt;
+  }
+}
+
+// ITK 5.2's NIfTI reader asks whether the sform is affine by inverting the 4x4 matrix
+// M = [A t; 0 0 0 1] (A: the 3x3 part of srow_x..srow_z, t: their offsets) with a
+// single-precision SVD (vnl_svd<float>, LINPACK's ssvdc), and uses the sform only if that SVD
+// finds M well-conditioned in single precision. On some matrices singular to single precision
+// the SVD produces a NaN and never returns, and neither does the reader: A singular (a zero
+// row), or A regular beside an offset of 5e7 and an entry of 3e-39 (found by fuzz/). Measured
+// on that SVD with random matrices of the magnitudes a header allows, each run under a time
+// limit: every matrix that hung had a condition number above 1e8, and either A singular to
+// single precision or nonzero magnitudes (with the 1 of the last row) more than 1e42 apart;
+// none of 80,000 with a condition number up to 1e7 hung, nor any of 40,000 with A's condition
+// number up to 1e7 and magnitudes within 1e24. Those two classes are accepted, the rest
+// refused: ITK would not use such an sform anyway (it falls back to the qform). Real sforms are
+// in the first class, or in the second when offsets are large beside the voxels (1 um voxels
+// 5 cm from the origin: a condition number of 1e9, magnitudes 1e21 apart with the rounding
+// residues of 1e-17 that rotations leave).
+constexpr double kMaxSformCondition = 1e7;
+constexpr double kMaxSformMagnitudeRatio = 1e24;
+
+/// The Frobenius condition number ||M|| ||M^-1|| (at least the 2-norm one) of the sform s
+/// (srow_x, srow_y, srow_z in float, as niftilib holds them), computed in double from
+/// M^-1 = [A^-1, -A^-1 t; 0 1]: of the 4x4 M when `withOffsets`, else of A alone. Infinite or
+/// NaN when A is singular.
+double sformCondition(const float s[12], bool withOffsets) {
+  auto a = [&](int r, int c) { return double(s[4 * r + c]); };
+  const double cof[3][3] = {{a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1), a(0, 2) * a(2, 1) - a(0, 1) * a(2, 2),
+                             a(0, 1) * a(1, 2) - a(0, 2) * a(1, 1)},
+                            {a(1, 2) * a(2, 0) - a(1, 0) * a(2, 2), a(0, 0) * a(2, 2) - a(0, 2) * a(2, 0),
+                             a(0, 2) * a(1, 0) - a(0, 0) * a(1, 2)},
+                            {a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0), a(0, 1) * a(2, 0) - a(0, 0) * a(2, 1),
+                             a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0)}};  // A^-1 = cof / det
+  const double det = a(0, 0) * cof[0][0] + a(0, 1) * cof[1][0] + a(0, 2) * cof[2][0];
+  double norm = withOffsets ? 1 : 0, inverseNorm = norm;  // (the 1 of the last rows)
+  for (int r = 0; r < 3; ++r) {
+    double shift = 0;
+    for (int c = 0; c < 4; ++c)
+      if (c < 3 || withOffsets) norm += a(r, c) * a(r, c);
+    for (int c = 0; c < 3; ++c) {
+      const double inv = cof[r][c] / det;
+      inverseNorm += inv * inv;
+      shift -= inv * a(c, 3);
+    }
+    if (withOffsets) inverseNorm += shift * shift;
+  }
+  return std::sqrt(norm) * std::sqrt(inverseNorm);
+}
+
+/// Why ITK cannot read the sform s (above), or nothing.
+std::optional<std::string> sformTrouble(const float s[12]) {
+  char text[240];
+  const double conditionA = sformCondition(s, false);
+  if (!(conditionA <= kMaxSformCondition)) {
+    std::snprintf(text, sizeof text,
+                  "the sform (srow_x to srow_z) is singular to single precision (the condition number of its "
+                  "3x3 part is %.2g, above 1e7), which ITK's NIfTI reader cannot take",
+                  conditionA);
+    return std::string(text);
+  }
+  const double condition = sformCondition(s, true);
+  if (condition <= kMaxSformCondition) return std::nullopt;
+  double big = 1, small = 1;
+  for (int i = 0; i < 12; ++i)
+    if (s[i] != 0) {
+      big = std::max(big, double(std::abs(s[i])));
+      small = std::min(small, double(std::abs(s[i])));
+    }
+  if (big <= kMaxSformMagnitudeRatio * small) return std::nullopt;
+  std::snprintf(text, sizeof text,
+                "the sform (srow_x to srow_z) is singular to single precision (condition number %.2g, above "
+                "1e7) and mixes magnitudes %.2g and %.2g (more than 1e24 apart), which ITK's NIfTI reader "
+                "cannot take",
+                condition, big, small);
+  return std::string(text);
+}
+
+/// The NIfTI-1 datatypes that are not one scalar of the ten types (nifti1.h; DT_BINARY, 1, is
+/// not one niftilib reads from a NIfTI file), or nullptr.
+const char* otherNiftiType(int datatype) {
+  switch (datatype) {
+    case 32: return "complex64";     // DT_COMPLEX64
+    case 128: return "rgb24";        // DT_RGB24
+    case 1536: return "float128";    // DT_FLOAT128
+    case 1792: return "complex128";  // DT_COMPLEX128
+    case 2048: return "complex256";  // DT_COMPLEX256
+    case 2304: return "rgba32";      // DT_RGBA32
+    default: return nullptr;
   }
 }
 
@@ -93,7 +184,12 @@ std::optional<DataLayout> parseNifti1Header(std::string_view head, std::uint64_t
     };
     requireFinite2(104, 4, "pixdim");
     if (r2.get<std::int32_t>(344) > 0) requireFinite2(352, 6, "the qform (quatern_b to qoffset_z)");
-    if (r2.get<std::int32_t>(348) > 0) requireFinite2(400, 12, "the sform (srow_x to srow_z)");
+    if (r2.get<std::int32_t>(348) > 0) {
+      requireFinite2(400, 12, "the sform (srow_x to srow_z)");
+      float sform[12];  // (niftilib's matrices are float, whatever the header stores)
+      for (int i = 0; i < 12; ++i) sform[i] = float(r2.get<double>(400 + 8 * std::size_t(i)));
+      if (const auto trouble = sformTrouble(sform)) throw HeaderError("malformed NIfTI-2 header: " + *trouble);
+    }
     layout.decodeReason = "it is a NIfTI-2 file";
     return layout;
   }
@@ -111,7 +207,12 @@ std::optional<DataLayout> parseNifti1Header(std::string_view head, std::uint64_t
   };
   requireFinite(76, 4, "pixdim");
   if (r.get<std::int16_t>(252) > 0) requireFinite(256, 6, "the qform (quatern_b to qoffset_z)");
-  if (r.get<std::int16_t>(254) > 0) requireFinite(280, 12, "the sform (srow_x to srow_z)");
+  if (r.get<std::int16_t>(254) > 0) {
+    requireFinite(280, 12, "the sform (srow_x to srow_z)");
+    float sform[12];
+    for (int i = 0; i < 12; ++i) sform[i] = r.get<float>(280 + 4 * std::size_t(i));
+    if (const auto trouble = sformTrouble(sform)) throw HeaderError("malformed NIfTI-1 header: " + *trouble);
+  }
 
   // Without the magic, niftilib (readVolume) reads the header as Analyze 7.5 and makes up
   // voxels it does not find: a .nii must say "n+1", or "ni1" for voxels in a separate .img file
@@ -142,8 +243,11 @@ std::optional<DataLayout> parseNifti1Header(std::string_view head, std::uint64_t
   const int datatype = r.get<std::int16_t>(70);
   const auto type = niftiType(datatype);
   if (!type) {
-    because("its NIfTI datatype is " + std::to_string(datatype));
-    return layout;
+    // Refused here rather than by ITK, whose niftilib prints its own line on stderr first.
+    if (const char* name = otherNiftiType(datatype))
+      throw HeaderError(std::string("its voxels are ") + name + " (NIfTI datatype " + std::to_string(datatype) +
+                        "); surftrack reads one scalar per voxel, of type " + supportedTypesText());
+    throw HeaderError("malformed NIfTI-1 header: datatype " + std::to_string(datatype) + " is not a NIfTI-1 datatype");
   }
   layout.type = *type;
   // niftilib's nifti_read_buffer sets non-finite float32 and float64 voxels to 0.
@@ -151,9 +255,13 @@ std::optional<DataLayout> parseNifti1Header(std::string_view head, std::uint64_t
   layout.bigEndian = swapped && sizeOf(*type) > 1;
   if (layout.bigEndian) because("its voxels are big-endian");
 
-  // scl_slope = 0 means no scaling; ITK rescales (and may change the voxel type) otherwise.
-  const float slope = r.get<float>(112), inter = r.get<float>(116);
-  if (slope != 0 && (slope != 1 || inter != 0)) because("its voxels are scaled (scl_slope, scl_inter)");
+  // The NIfTI-1 header calls scl_slope = 0 unscaled, but ITK 5.2 reads it as a slope of 1 and
+  // adds scl_inter (niftilib reads a non-finite slope or intercept as 0 first): only a slope of
+  // 0 or 1 with no intercept leaves the voxels as stored. ITK rescales (and may change the voxel
+  // type) otherwise.
+  const auto finiteOrZero = [](float v) { return std::isfinite(v) ? v : 0.0f; };
+  const float slope = finiteOrZero(r.get<float>(112)), inter = finiteOrZero(r.get<float>(116));
+  if ((slope != 0 && slope != 1) || inter != 0) because("its voxels are scaled (scl_slope, scl_inter)");
 
   const float voxOffset = r.get<float>(108);
   if (!(voxOffset >= 0) || !std::isfinite(voxOffset))

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <regex>
 #include <sstream>
 #include <tuple>
 #include <utility>
@@ -34,6 +35,9 @@
 #include <zlib.h>
 
 #include "Internal.h"
+#include "MappedFile.h"
+#include "TiffStack.h"
+#include "VolumeHeader.h"
 
 namespace surftrack::io {
 
@@ -60,21 +64,40 @@ void registerFactories() {
   });
 }
 
-/// An ITK exception's description on one line.
+/// An ITK exception as one line for a user: its description with white space collapsed,
+/// without ITK's "ITK ERROR: NrrdImageIO(0x55e4aa74c3b0): " (a pointer tells a user nothing;
+/// the reader's name is kept, as "ITK's NrrdImageIO: "), and of teem's chain of messages
+/// "[nrrd] nrrdLoad: trouble ... [nrrd] _nrrdEncodingGzip_read: expected 48 bytes but received
+/// 44" (ITK's NRRD reader) only the last one, which says what is wrong.
 std::string oneLine(const itk::ExceptionObject& e) {
-  std::string text = e.GetDescription() ? e.GetDescription() : "";
-  std::string out;
+  std::string text;
   bool space = false;
-  for (char ch : text) {
+  for (const char* p = e.GetDescription() ? e.GetDescription() : ""; *p; ++p) {
+    const char ch = *p;
     if (ch == '\n' || ch == '\r' || ch == '\t' || ch == ' ') {
-      space = !out.empty();
+      space = !text.empty();
       continue;
     }
-    if (space) out += ' ';
+    if (space) text += ' ';
     space = false;
-    out += ch;
+    text += ch;
   }
-  return out.empty() ? "ITK error" : out;
+  static const std::regex prefix(R"(^(ITK ERROR: )?([A-Za-z_][A-Za-z0-9_:]*)\(0x[0-9a-fA-F]+\): )");
+  std::string reader;
+  std::smatch m;
+  if (std::regex_search(text, m, prefix)) {
+    reader = m[2].str();
+    text = m.suffix().str();
+  } else if (text.rfind("ITK ERROR: ", 0) == 0) {
+    text.erase(0, 11);
+  }
+  if (const std::size_t last = text.rfind("[nrrd] "); last != std::string::npos) {
+    text.erase(0, last + 7);
+    static const std::regex function(R"(^[A-Za-z_][A-Za-z0-9_]*: )");
+    text = std::regex_replace(text, function, "", std::regex_constants::format_first_only);
+  }
+  if (text.empty()) text = "unknown error";
+  return reader.empty() ? "ITK: " + text : "ITK's " + reader + ": " + text;
 }
 
 std::string componentName(itk::IOComponentEnum c) {
@@ -166,10 +189,24 @@ ImagePointer<T> readSeriesAs(const std::vector<std::string>& files) {
   return image;
 }
 
-std::string unsupportedType(const std::string& path, const std::string& what) {
-  return "unsupported voxel type " + what + " in '" + path +
-         "': supported are uint8, int16, uint16, int32, float and double";
+/// A ReadError for voxels surftrack does not read: `what` says what they are ("its voxels have
+/// 3 components", "its voxel type is 'long double'").
+ReadError unsupportedType(const std::string& path, const std::string& what) {
+  return ReadError("cannot read '" + path + "': " + what + "; surftrack reads one scalar per voxel, of type " +
+                   supportedTypesText());
 }
+
+/// "its voxels have N components (RGB, complex or vector voxels)".
+std::string componentsText(unsigned components) {
+  return "its voxels have " + std::to_string(components) + " components (RGB, complex or vector voxels)";
+}
+
+/// What readWithItk read besides the image: the format, and a TIFF stack's unit and channel.
+struct ItkRead {
+  std::string format;
+  std::string unit;
+  int channel = 0, channels = 1;
+};
 
 /// Reads the first DICOM series of a directory and hands the image to `use`.
 template <class Use>
@@ -185,11 +222,12 @@ auto readDicomDirectory(const std::string& path, Use&& use) {
   dicom->SetFileName(files.front());
   dicom->ReadImageInformation();
   if (dicom->GetNumberOfComponents() != 1)
-    throw ReadError(unsupportedType(path, "with " + std::to_string(dicom->GetNumberOfComponents()) +
-                                              " components per voxel"));
+    throw unsupportedType(path, componentsText(dicom->GetNumberOfComponents()));
   const auto type = scalarTypeOf(dicom->GetComponentType());
-  if (!type) throw ReadError(unsupportedType(path, "'" + componentName(dicom->GetComponentType()) + "'"));
-  return visitScalarType(*type, [&](auto v) { return use(readSeriesAs<decltype(v)>(files), std::string("dicom")); });
+  if (!type) throw unsupportedType(path, "its voxel type is '" + componentName(dicom->GetComponentType()) + "'");
+  ItkRead read;
+  read.format = "dicom";
+  return visitScalarType(*type, [&](auto v) { return use(readSeriesAs<decltype(v)>(files), read); });
 }
 
 std::string lowerName(const std::string& path) {
@@ -376,10 +414,9 @@ itk::ImageIOBase::Pointer openImageIO(const std::string& path, ScalarType& type,
                       "D image with more than one volume; give a 3D image");
   }
   if (imageIO->GetNumberOfComponents() != 1)
-    throw ReadError(unsupportedType(
-        path, "with " + std::to_string(imageIO->GetNumberOfComponents()) + " components per voxel"));
+    throw unsupportedType(path, componentsText(imageIO->GetNumberOfComponents()));
   const auto t = scalarTypeOf(imageIO->GetComponentType());
-  if (!t) throw ReadError(unsupportedType(path, "'" + componentName(imageIO->GetComponentType()) + "'"));
+  if (!t) throw unsupportedType(path, "its voxel type is '" + componentName(imageIO->GetComponentType()) + "'");
   type = *t;
   return imageIO;
 }
@@ -397,21 +434,91 @@ std::string formatOf(const itk::ImageIOBase* imageIO, const std::string& path) {
   return ext.size() > 1 ? ext.substr(1) : io;
 }
 
+/// The ImageJ or OME metadata of the TIFF `path` (io/TiffStack.h).
+TiffStack tiffStackOf(const std::string& path) {
+  const detail::OpenFile file(path, "cannot read '" + path + "'");
+  try {
+    return parseTiffStack(
+        [&](std::uint64_t offset, std::size_t bytes) {
+          std::string out(bytes, '\0');
+          out.resize(file.readAt(offset, out.data(), bytes));
+          return out;
+        },
+        file.size(), fs::path(path).filename().string());
+  } catch (const HeaderError& e) {
+    throw ReadError("cannot read '" + path + "': " + e.what());
+  }
+}
+
+/// The slices of channel `channel` of a TIFF stack that ITK read as one volume of all its pages
+/// (a copy, unless the stack has one channel), with the voxel size its metadata states.
+template <class T>
+ImagePointer<T> stackChannel(const ImagePointer<T>& pages, const TiffStack& stack, int channel, const std::string& path) {
+  using Image = itk::Image<T, 3>;
+  const auto size = pages->GetLargestPossibleRegion().GetSize();
+  if (std::int64_t(size[2]) != stack.pages())
+    throw ReadError("cannot read '" + path + "': its " + stack.source + " metadata announces " +
+                    std::to_string(stack.pages()) + " images (" + std::to_string(stack.channels) + " channels x " +
+                    std::to_string(stack.slices) + " slices), and ITK reads " + std::to_string(size[2]) + " pages");
+  if (stack.width != 0 && (std::int64_t(size[0]) != stack.width || std::int64_t(size[1]) != stack.height))
+    throw ReadError("cannot read '" + path + "': its OME metadata announces " + std::to_string(stack.width) + " x " +
+                    std::to_string(stack.height) + " pixels a plane, and ITK reads " + std::to_string(size[0]) + " x " +
+                    std::to_string(size[1]));
+  ImagePointer<T> out = pages;
+  if (stack.channels > 1) {
+    out = Image::New();
+    typename Image::SizeType outSize = size;
+    outSize[2] = std::size_t(stack.slices);
+    out->SetRegions(typename Image::RegionType(outSize));
+    out->SetSpacing(pages->GetSpacing());
+    out->SetOrigin(pages->GetOrigin());
+    out->SetDirection(pages->GetDirection());
+    out->Allocate();
+    const std::size_t plane = size[0] * size[1];
+    for (std::int64_t z = 0; z < stack.slices; ++z) {
+      const std::int64_t page = stack.channelFirst ? channel + stack.channels * z : z + stack.slices * channel;
+      const T* from = pages->GetBufferPointer() + std::size_t(page) * plane;
+      std::copy(from, from + plane, out->GetBufferPointer() + std::size_t(z) * plane);
+    }
+  }
+  if (stack.spacing) {
+    typename Image::SpacingType spacing;
+    for (int a = 0; a < 3; ++a) spacing[a] = (*stack.spacing)[a];
+    out->SetSpacing(spacing);
+  }
+  return out;
+}
+
 /// Reads `path` with ITK (a file, or a directory holding a DICOM series) and hands the decoded
-/// image and its format to `use`; readVolume's checks, ITK's errors as ReadError.
+/// image and what else was read (ItkRead) to `use`; readVolume's checks, ITK's errors as
+/// ReadError.
 template <class Use>
-auto readWithItk(const std::string& path, Use&& use) {
+auto readWithItk(const std::string& path, const ReadOptions& options, Use&& use) {
   registerFactories();
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
   try {
-    if (fs::is_directory(path, ec)) return readDicomDirectory(path, use);
+    if (fs::is_directory(path, ec)) {
+      detail::requireChannel(path, options, 1, "");
+      return readDicomDirectory(path, use);
+    }
     ScalarType type{};
     std::size_t voxels = 0;
     itk::ImageIOBase::Pointer imageIO = openImageIO(path, type, voxels);
     requireCompleteData(imageIO, path, voxels);
-    const std::string format = formatOf(imageIO, path);
-    return visitScalarType(type, [&](auto v) { return use(readFileAs<decltype(v)>(imageIO, path), format); });
+    ItkRead read;
+    read.format = formatOf(imageIO, path);
+    TiffStack stack;
+    if (read.format == "tiff") stack = tiffStackOf(path);
+    read.unit = stack.unit;
+    read.channels = int(stack.channels);
+    read.channel = detail::requireChannel(path, options, stack.channels, stack.channelsField);
+    return visitScalarType(type, [&](auto v) {
+      using T = decltype(v);
+      ImagePointer<T> image = readFileAs<T>(imageIO, path);
+      if (!stack.source.empty()) image = stackChannel<T>(image, stack, read.channel, path);
+      return use(image, read);
+    });
   } catch (const itk::ExceptionObject& e) {
     throw ReadError("cannot read '" + path + "': " + oneLine(e));
   } catch (const std::bad_alloc&) {
@@ -421,20 +528,38 @@ auto readWithItk(const std::string& path, Use&& use) {
 
 }  // namespace
 
-AnyVolume readVolume(const std::string& path) {
-  return readWithItk(path, [&](auto image, const std::string&) -> AnyVolume {
+AnyVolume readVolume(const std::string& path, const ReadOptions& options) {
+  return readWithItk(path, options, [&](auto image, const ItkRead&) -> AnyVolume {
     return toDense(image.GetPointer(), path);
   });
 }
 
 namespace detail {
 
-LoadedVolume decodeWithItk(const std::string& path) {
-  return readWithItk(path, [&](auto image, const std::string& format) -> LoadedVolume {
+LoadedVolume decodeWithItk(const std::string& path, const ReadOptions& options) {
+  return readWithItk(path, options, [&](auto image, const ItkRead& read) -> LoadedVolume {
     LoadedVolume out = toLoaded(image, path);
-    out.format = format;
+    out.format = read.format;
+    out.unit = read.unit;
+    out.channel = read.channel;
+    out.channels = read.channels;
     return out;
   });
+}
+
+int requireChannel(const std::string& path, const ReadOptions& options, std::int64_t channels, const std::string& field) {
+  const std::string last = std::to_string(channels - 1);
+  if (!options.channel) {
+    if (channels == 1) return 0;
+    throw ReadError("cannot read '" + path + "': it has " + std::to_string(channels) + " channels (" + field +
+                    "); choose one with --channel C, C from 0 to " + last);
+  }
+  const int c = *options.channel;
+  if (c < 0 || c >= channels)
+    throw ReadError("cannot read '" + path + "': there is no channel " + std::to_string(c) + " (--channel): " +
+                    (channels == 1 ? std::string("it has one channel, 0")
+                                   : "it has " + std::to_string(channels) + " channels (" + field + "), 0 to " + last));
+  return c;
 }
 
 ItkHeader readItkHeader(const std::string& path) {

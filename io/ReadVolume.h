@@ -29,6 +29,10 @@ using AnyVolume = std::variant<DenseImage<std::uint8_t>, DenseImage<std::int8_t>
                                DenseImage<std::uint64_t>, DenseImage<std::int64_t>,
                                DenseImage<float>, DenseImage<double>>;
 
+/// "uint8, int8, uint16, int16, uint32, int32, uint64, int64, float or double": the voxel types
+/// a volume may have (one scalar per voxel), for messages.
+std::string supportedTypesText();
+
 ScalarType scalarTypeOf(const AnyVolume& volume);
 const Dims& dimsOf(const AnyVolume& volume);
 const ImageGeometry& geometryOf(const AnyVolume& volume);
@@ -41,10 +45,19 @@ class ReadError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// How to read a volume file.
+struct ReadOptions {
+  /// The channel to read, from 0, of a stack of several channels: a TIFF whose ImageJ or OME
+  /// metadata announces them (io/TiffStack.h). Such a stack is a ReadError without one; any
+  /// other file has one channel, 0.
+  std::optional<int> channel;
+};
+
 /// Reads a volume with ITK. `path` is a file in a format ITK recognises (.nii, .nii.gz, .nrrd,
-/// .nhdr, .mha, .mhd, a single DICOM file, ...) or a directory holding one DICOM series.
-/// 2D images become one slice. Throws ReadError.
-AnyVolume readVolume(const std::string& path);
+/// .nhdr, .mha, .mhd, a single DICOM file, .tif, ...) or a directory holding one DICOM series.
+/// 2D images become one slice. A TIFF stack with ImageJ or OME metadata gives the slices of one
+/// channel and the voxel size the metadata states. Throws ReadError.
+AnyVolume readVolume(const std::string& path, const ReadOptions& options = {});
 
 /// The layout of a headerless raw file: x fastest, then y, then z.
 struct RawLayout {

@@ -13,6 +13,13 @@
 
 namespace surftrack::io {
 
+std::string supportedTypesText() {
+  std::string out;
+  constexpr int kLast = int(ScalarType::Float64);  // (the ten types, in ScalarType's order)
+  for (int t = 0; t <= kLast; ++t) out += (t == 0 ? "" : t == kLast ? " or " : ", ") + toString(ScalarType(t));
+  return out;
+}
+
 ScalarType scalarTypeOf(const AnyVolume& volume) {
   return std::visit([](const auto& image) {
     return surftrack::scalarTypeOf<typename std::decay_t<decltype(image)>::value_type>();

@@ -19,6 +19,7 @@ packages=(
   python3-dev python3-numpy pybind11-dev   # the Python package (Debian's python3, /usr/bin/python3)
   python3-pytest python3-skimage python3-nibabel python3-meshio  # its tests and examples
   python3-venv python3-pip python3-setuptools  # 'pip install --no-build-isolation .' in a venv
+  python3-tifffile               # TIFF stacks (ImageJ, OME-TIFF) written independently for tests/test_tiff_stacks.py
   mricron-data                   # real MRI volumes used by the demo and one test
 )
 

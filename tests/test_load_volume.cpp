@@ -28,6 +28,7 @@
 
 #include "LoadVolume.h"
 #include "ReadVolume.h"
+#include "VolumeHeader.h"
 
 namespace fs = std::filesystem;
 using namespace surftrack;
@@ -312,7 +313,9 @@ TYPED_TEST(LoadEveryType, CompressedFilesAreDecodedOnce) {
     // A .nii.gz is inflated by the loader, its voxels 64-byte aligned; the others by ITK.
     const bool gzippedNifti = name == "c.nii.gz";
     EXPECT_NE(loaded.decodeReason.find(gzippedNifti ? "inflated into memory" : "ITK"), std::string::npos) << loaded.decodeReason;
-    if (gzippedNifti) EXPECT_EQ(reinterpret_cast<std::uintptr_t>(loaded.view.data) % 64, 0u);
+    if (gzippedNifti) {
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(loaded.view.data) % 64, 0u);
+    }
     expectSame(loaded, io::readVolume(path), path);
     expectVoxels(loaded, image);
   }
@@ -469,6 +472,30 @@ TEST(LoadVolume, ScaledNiftiIsDecodedByItk) {
   expectSame(loaded, io::readVolume(path), path);
 }
 
+/// scl_slope = 0 with an scl_inter: the NIfTI-1 header calls it unscaled, but ITK 5.2 reads the
+/// slope as 1 and adds the intercept (as it does for a NaN slope). Float voxels keep their type
+/// then, so a mapping of the stored values would differ from readVolume (found by fuzz/): the
+/// loader decodes them as ITK does, stored value + intercept.
+TEST(LoadVolume, NiftiSlopeZeroWithAnInterceptIsReadAsItkReadsIt) {
+  TempDir dir;
+  const DenseImage<float> image = makeVolume<float>(kDims);
+  for (const float slope : {0.0f, std::nanf("")}) {
+    const std::string path = dir / "slope0.nii";
+    io::writeVolume(io::AnyVolume(image), path);
+    std::string bytes = contents(path);
+    const float inter = 0.5f;
+    std::memcpy(&bytes[112], &slope, 4);
+    std::memcpy(&bytes[116], &inter, 4);
+    writeFile(path, bytes);
+    const LoadedVolume loaded = io::loadVolume(path);
+    EXPECT_FALSE(loaded.mapped) << slope;
+    expectSame(loaded, io::readVolume(path), path);
+    ASSERT_EQ(loaded.view.type, ScalarType::Float32);
+    const auto* v = static_cast<const float*>(loaded.view.data);
+    for (std::size_t i = 0; i < image.data().size(); ++i) ASSERT_EQ(v[i], image.data()[i] + inter) << i;
+  }
+}
+
 TEST(LoadVolume, NiftiFloatsWithNanAreDecodedAsReadVolumeReadsThem) {
   TempDir dir;
   for (const bool isDouble : {false, true}) {
@@ -520,7 +547,10 @@ TEST(LoadVolume, NumberedAndListedDataFilesAreDecodedByItk) {
   const std::string list = dir / "list.nhdr";
   writeFile(list, nrrdHeader("uint16", kDims, "endian: little\nencoding: raw\ndata file: LIST\n") +
                       "slice1.raw\nslice2.raw\nslice3.raw\n");
-  for (const std::string& path : {mhd, nhdr, list}) {
+  // A MetaImage list whose last name ends the file without its newline (MetaIO reads it).
+  const std::string metaList = dir / "list.mhd";
+  writeFile(metaList, metaHeader("MET_USHORT", kDims, "", "LIST") + "slice1.raw\nslice2.raw\nslice3.raw");
+  for (const std::string& path : {mhd, nhdr, list, metaList}) {
     const LoadedVolume loaded = io::loadVolume(path);
     EXPECT_FALSE(loaded.mapped) << path;
     EXPECT_NE(loaded.decodeReason.find("files"), std::string::npos) << loaded.decodeReason;
@@ -833,6 +863,10 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
       {"missinglist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nnowhere.raw\nok.raw\n", "no such file"},
       {"dirlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\n.\nok.raw\n", "directory"},
       {"shortfile.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\ntiny.raw\nok.raw\n", "truncated"},
+      // A list cut short after a name without its newline: the parser read past its buffer
+      // (std::out_of_range, found by fuzz/).
+      {"cutlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nok.raw", "lists 2 data files"},
+      {"cutlist1.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ab", "lists 1 data files"},
       // ITK's matrix code aborts on the infinity 1e200 * 1e200 makes.
       {"huge.mha", "ObjectType = Image\nNDims = 3\nDimSize = 7 5 3\nElementSpacing = 1e200 1e200 1e200\n"
                    "TransformMatrix = 1e200 0 0 0 1e200 0 0 0 1e200\nElementType = MET_SHORT\nElementDataFile = LOCAL\n" + data,
@@ -893,6 +927,26 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
     cases.push_back({"nifti2size.nii", mixed, "sizeof_hdr 540"});
     const float far = 1e24f;
     cases.push_back({"faroffset.nii", with(108, &far, 4), "truncated"});
+    // An sform singular to single precision, with an offset of 5e7 beside 3e-39 (a fuzzer's
+    // finding): ITK 5.2's NIfTI reader never returned on it.
+    {
+      std::string b = bytes;
+      const std::int16_t qformCode = 0, sformCode = 1;
+      const float sform[12] = {1, 0, -5e7f, 0, 1, 0, 1, 3e-39f, 0, 1, 5e7f, 0};
+      std::memcpy(&b[252], &qformCode, 2);
+      std::memcpy(&b[254], &sformCode, 2);
+      std::memcpy(&b[280], sform, sizeof sform);
+      cases.push_back({"singularsform.nii", b, "sform (srow_x to srow_z) is singular"});
+      // Found by a search of random sforms on which ITK's SVD never returns: a rotation of
+      // 1 um voxels (in mm) beside offsets of 4e12 and 2.6e-30.
+      const float regular[12] = {0.00107906f, 0.000295631f, 0, -4.1007e+12f, -0.000295631f, 0.00107906f, 0, 0,
+                                 0, 0, 0.00146083f, -2.58811e-30f};
+      std::memcpy(&b[280], regular, sizeof regular);
+      cases.push_back({"offsetsform.nii", b, "more than 1e24 apart"});
+    }
+    // Datatypes niftilib rejects with a line of its own on stderr, or that are not one scalar.
+    const std::int16_t badType = 9999;
+    cases.push_back({"datatype.nii", with(70, &badType, 2), "datatype 9999 is not a NIfTI-1 datatype"});
   }
   for (const Case& c : cases) {
     const std::string path = dir / c.name;
@@ -913,6 +967,218 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
     expectReadError([&] { io::loadVolume(locked); }, {locked});
   }
 }
+
+/// A NIfTI sform with small voxels far from the origin (1 um voxels, in mm, half a metre away:
+/// a condition number near 1e9) is not refused with the singular ones above: ITK reads it (from
+/// the qform it falls back to), with the geometry it was written with.
+TEST(LoadVolume, SmallVoxelsFarFromTheOriginLoad) {
+  TempDir dir;
+  ImageGeometry g = testGeometry();
+  g.spacing = {1e-3, 1e-3, 2e-3};
+  g.origin = {500, -400, 300};
+  const std::string path = dir / "far.nii";
+  io::writeVolume(io::AnyVolume(makeVolume<std::int16_t>(kDims, g)), path);
+  const LoadedVolume loaded = io::loadVolume(path);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(loaded.view.geometry.spacing[i], g.spacing[i], 1e-8);
+    EXPECT_NEAR(loaded.view.geometry.origin[i], g.origin[i], 1e-3);
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(loaded.view.geometry.direction[i][j], g.direction[i][j], 1e-5);
+  }
+}
+
+/// What ITK refuses reaches the user as one line without ITK's pointers ("NrrdImageIO(0x55...)")
+/// or its "ITK ERROR:", saying what is wrong, and nothing else is printed on stderr.
+TEST(LoadVolume, ItkErrorsAreOneLineWithoutPointers) {
+  TempDir dir;
+  // gzip-encoded voxels that end early: teem's chain of messages ends with what is wrong.
+  const std::string cut = dir / "cut.nrrd";
+  const std::string full = gzipped(std::string(7 * 5 * 3 * 2, '\5'));
+  writeFile(cut, nrrdHeader("int16", kDims, "endian: little\nencoding: gzip\n") + "\n" + full.substr(0, full.size() - 12));
+  // A NIfTI datatype niftilib does not know: refused before niftilib prints its own line.
+  const std::string nifti = dir / "datatype.nii";
+  io::writeVolume(io::AnyVolume(makeVolume<std::int16_t>(kDims)), nifti);
+  std::string bytes = contents(nifti);
+  const std::int16_t badType = 1;  // DT_BINARY: niftilib's "bad datatype"
+  std::memcpy(&bytes[70], &badType, 2);
+  writeFile(nifti, bytes);
+  for (const std::string& path : {cut, nifti}) {
+    SCOPED_TRACE(path);
+    testing::internal::CaptureStderr();
+    std::string message;
+    try {
+      io::loadVolume(path);
+    } catch (const io::ReadError& e) {
+      message = e.what();
+    }
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_EQ(message.find("(0x"), std::string::npos) << message;
+    EXPECT_EQ(message.find("ITK ERROR"), std::string::npos) << message;
+    EXPECT_EQ(message.find("[nrrd]"), std::string::npos) << message;
+    EXPECT_EQ(err, "") << "printed on stderr besides the error";
+  }
+}
+
+/// A file whose voxels are not one scalar of a supported type: the message lists the types, and
+/// every type it lists loads (as a NRRD file written here, the type by the message's name).
+TEST(LoadVolume, UnsupportedVoxelsNameTheTypesThatLoad) {
+  TempDir dir;
+  const std::string nifti = dir / "complex.nii";  // NIfTI complex64
+  io::writeVolume(io::AnyVolume(makeVolume<float>(kDims)), nifti);
+  std::string bytes = contents(nifti);
+  const std::int16_t complex64 = 32, bits = 64;
+  std::memcpy(&bytes[70], &complex64, 2);
+  std::memcpy(&bytes[72], &bits, 2);
+  writeFile(nifti, bytes + std::string(kDims.count() * 4, '\0'));
+  const std::string channels = dir / "channels.mha";  // three channels per voxel: ITK's vector
+  writeFile(channels, metaHeader("MET_UCHAR", kDims, "ElementNumberOfChannels = 3\n", "LOCAL") +
+                          std::string(kDims.count() * 3, '\7'));
+  for (const auto& [path, what] : {std::pair{nifti, std::string("complex64")}, std::pair{channels, std::string("3 components")}}) {
+    SCOPED_TRACE(path);
+    std::string message;
+    try {
+      io::loadVolume(path);
+      ADD_FAILURE() << "loaded";
+    } catch (const io::ReadError& e) {
+      message = e.what();
+    }
+    EXPECT_NE(message.find(what), std::string::npos) << message;
+    const std::string lead = "of type ";
+    const std::size_t at = message.find(lead);
+    ASSERT_NE(at, std::string::npos) << message;
+    std::vector<std::string> names;
+    std::string list = message.substr(at + lead.size());
+    for (std::size_t start = 0;;) {
+      std::size_t end = list.find(", ", start);
+      const std::size_t orAt = list.find(" or ", start);
+      if (end == std::string::npos || (orAt != std::string::npos && orAt < end)) end = orAt;
+      names.push_back(list.substr(start, end == std::string::npos ? std::string::npos : end - start));
+      if (end == std::string::npos) break;
+      start = end + (list.compare(end, 4, " or ") == 0 ? 4 : 2);
+    }
+    EXPECT_EQ(names.size(), 10u) << message;
+    for (const std::string& name : names) {
+      const ScalarType type = io::parseScalarType(name);
+      const std::string file = dir / ("listed-" + name + ".nrrd");
+      writeFile(file, nrrdHeader(name, kDims, "endian: little\nencoding: raw\n") + "\n" +
+                          std::string(kDims.count() * sizeOf(type), '\1'));
+      const LoadedVolume loaded = io::loadVolume(file);
+      EXPECT_EQ(loaded.view.type, type) << name;
+    }
+  }
+}
+
+/// Every prefix of a valid header, parsed as a whole file and as the head of a longer one: the
+/// parsers of io/VolumeHeader.h give a layout, ask for more bytes (only of a longer file) or
+/// throw HeaderError — never another exception (a substr past the buffer throws
+/// std::out_of_range), whatever byte the cut falls on.
+TEST(LoadVolume, EveryCutOfAHeaderIsAHeaderErrorOrMoreBytes) {
+  TempDir dir;
+  std::vector<std::pair<std::string, std::string>> files = {
+      {"mhd", metaHeader("MET_SHORT", kDims, "ElementNumberOfChannels = 1\n", "LIST") + "a.raw\nb.raw\r\nc.raw\n"},
+      {"mhd", metaHeader("MET_SHORT", kDims, "", "slice%03d.raw 1 3 1")},
+      {"nhdr", nrrdHeader("int16", kDims, "endian: little\nencoding: raw\ndata file: LIST\n") + "a.raw\r\nb.raw\rc.raw\n"},
+      {"nhdr", nrrdHeader("int16", kDims, "endian: little\nencoding: raw\ndata file: s%02d.raw 1 3 1 2\n")},
+  };
+  for (const std::string ext : {"nii", "nrrd", "mha"}) {
+    const std::string path = dir / ("cut." + ext);
+    io::writeVolume(io::AnyVolume(makeVolume<std::int16_t>(kDims)), path);
+    files.emplace_back(ext, contents(path));
+  }
+  for (const auto& [ext, bytes] : files) {
+    const auto parse = ext == "nii" ? io::parseNifti1Header
+                     : ext == "mha" || ext == "mhd" ? io::parseMetaImageHeader
+                                                    : io::parseNrrdHeader;
+    int layouts = 0;
+    for (std::size_t n = 0; n <= bytes.size(); ++n) {
+      const std::string head = bytes.substr(0, n);  // (a buffer of exactly n bytes)
+      for (const std::uint64_t fileSize : {std::uint64_t(n), std::uint64_t(bytes.size())}) {
+        SCOPED_TRACE(ext + ": the first " + std::to_string(n) + " of " + std::to_string(bytes.size()) +
+                     " bytes, of a file of " + std::to_string(fileSize));
+        try {
+          const auto layout = parse(head, fileSize);
+          if (!layout) {
+            EXPECT_LT(n, fileSize) << "more bytes asked of a whole file";
+          }
+          layouts += layout.has_value();
+        } catch (const io::HeaderError& e) {
+          EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+        } catch (const std::exception& e) {
+          ADD_FAILURE() << "not a HeaderError: " << e.what();
+        }
+      }
+    }
+    EXPECT_GT(layouts, 0) << ext << ": the whole header never parsed";
+  }
+}
+
+#ifdef SURFTRACK_FUZZ_DIR
+/// The fuzzers' corpus and kept findings (fuzz/corpus/<format>/, fuzz/findings/<format>/, of
+/// fuzz/run_fuzzers.sh), replayed as fuzz/fuzz_volume_header.cpp runs them, through this build:
+/// each input is a ReadError or a volume whose every voxel reads, with the type, dimensions
+/// and geometry of readVolume, and its voxels unless ITK decoded them (a finding once crashed,
+/// hung or made the two disagree; a hang would stop this test).
+TEST(LoadVolume, FuzzCorpusAndFindingsReplay) {
+  TempDir dir;
+  std::string pattern(65536, '\0');  // the fuzz target's data file next to each input
+  for (std::size_t i = 0; i < pattern.size(); ++i) pattern[i] = char(i * 131 + (i >> 8));
+  writeFile(dir / "data.raw", pattern);
+  int replayed = 0, findings = 0;
+  for (const std::string kind : {"corpus", "findings"}) {
+    const fs::path root = fs::path(SURFTRACK_FUZZ_DIR) / kind;
+    if (!fs::is_directory(root)) continue;
+    for (const auto& formatDir : fs::directory_iterator(root)) {
+      const std::string format = formatDir.path().filename().string();
+      for (const auto& entry : fs::directory_iterator(formatDir.path())) {
+        const std::string bytes = contents(entry.path().string());
+        SCOPED_TRACE(entry.path().string());
+        const std::string input = dir / ("input." + format);
+        io::ReadOptions options;
+        std::function<LoadedVolume()> load;
+        std::function<io::AnyVolume()> read;
+        if (format == "raw") {  // the layout from the first 5 bytes (fuzzRaw)
+          if (bytes.size() < 5) continue;
+          io::RawLayout layout;
+          const auto b = [&](int i) { return static_cast<unsigned char>(bytes[std::size_t(i)]); };
+          layout.type = ScalarType(b(0) % 10);
+          layout.bigEndian = b(0) & 0x80;
+          layout.headerBytes = b(1) % 32;
+          layout.dims = {1 + b(2) % 16, 1 + b(3) % 16, 1 + b(4) % 16};
+          writeFile(input, bytes.substr(5));
+          load = [=] { return io::loadRawVolume(input, layout); };
+          read = [=] { return io::readRawVolume(input, layout); };
+        } else {
+          if (format == "tif" && bytes.size() % 3 != 0) options.channel = int(bytes.size() % 3) - 1;
+          writeFile(input, bytes);
+          load = [=] { return io::loadVolume(input, options); };
+          read = [=] { return io::readVolume(input, options); };
+        }
+        ++replayed;
+        findings += kind == "findings";
+        LoadedVolume loaded;
+        try {
+          loaded = load();
+        } catch (const io::ReadError& e) {
+          EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+          continue;
+        }
+        const io::AnyVolume volume = read();
+        const bool decoded = loaded.decodeReason.find("(decoded by ITK)") != std::string::npos;
+        if (!decoded) {
+          expectSame(loaded, volume, entry.path().string());
+          continue;
+        }
+        ASSERT_EQ(loaded.view.type, io::scalarTypeOf(volume));
+        ASSERT_EQ(loaded.view.dims, io::dimsOf(volume));
+        for (int i = 0; i < 3; ++i) EXPECT_NEAR(loaded.view.geometry.spacing[i], io::geometryOf(volume).spacing[i], 1e-9);
+      }
+    }
+  }
+  EXPECT_GT(findings, 0) << SURFTRACK_FUZZ_DIR "/findings holds no finding";
+  std::printf("[          ] %d inputs replayed, %d of them kept findings\n", replayed, findings);
+}
+#endif
 
 /// Random damage to the headers of valid files: a ReadError or a volume whose every voxel can be
 /// read, never a crash (the fuzzer, fuzz/, does this at scale).
