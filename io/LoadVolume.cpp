@@ -330,10 +330,10 @@ static LoadedVolume loadFile(const std::string& path, const ReadOptions& options
           throw ReadError(separate->context() + ": " + e.what());
         }
       }
-      // A MetaImage's list of files: each a regular file with its part of the voxels (MetaIO
-      // reads what it cannot open into its buffer, and may crash).
+      // A list of files: each a regular file with its part of the voxels (MetaIO reads what it
+      // cannot open into its buffer, and may crash).
       if (!layout.listedFiles.empty()) {
-        const std::uint64_t part = layout.dataBytes() / layout.listedFiles.size();
+        const std::uint64_t part = layout.listedPartBytes;
         for (const std::string& listed : layout.listedFiles) {
           const std::string data = dataPath(path, listed);
           const detail::OpenFile each(data, "cannot read " + quoted(path) + ": its listed data file " + quoted(data));

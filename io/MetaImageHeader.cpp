@@ -241,7 +241,28 @@ class Parser {
     }
     for (std::string_view word : out)
       if (word.size() >= kMaxWord) fail("has a word of more than 79 characters");
+    if (metaWordCount() != out.size())
+      fail("has three or more spaces in a row, which MetaIO counts as more words than it reads");
     return out;
+  }
+
+  /// The words MetaIO's MET_StringToWordArray counts in value_ (which has no trailing space):
+  /// one more than the spaces that follow a non-space or an odd space of a run — a run of three
+  /// or more spaces counts twice or more. MetaIO allocates that many words, fills those it finds,
+  /// and then reads the others (uninitialised pointers: it crashed under fuzz/).
+  std::size_t metaWordCount() const {
+    std::size_t i = 0, n = 0;
+    while (i < value_.size() && value_[i] == ' ') ++i;
+    bool space = false;
+    for (; i < value_.size(); ++i) {
+      if (value_[i] == ' ' && !space) {
+        ++n;
+        space = true;
+      } else {
+        space = false;
+      }
+    }
+    return value_.empty() ? 0 : n + 1;
   }
 
   /// "ElementDataFile = <pattern> [<first> [<last> [<step>]]]", numbered files as MetaIO reads
@@ -300,6 +321,7 @@ class Parser {
       layout.severalDataFiles = value_.substr(0, 4) == "LIST" || value_.find('%') != std::string_view::npos;
       if (value_.substr(0, 4) == "LIST") {
         layout.listedFiles = listed_;
+        layout.listedPartBytes = layout.dataBytes() / listed_.size();  // (as MetaIO reads each)
         because("its voxels are in a list of files (ElementDataFile = LIST)");
       } else if (value_.find('%') != std::string_view::npos) {
         requireFilePattern();

@@ -7,6 +7,7 @@
 // "byteskip"); a field may appear once; an unknown field is an error, as in teem.
 #include <array>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -143,7 +144,10 @@ class Parser {
         return finish(next, /*blankLine=*/true);
       } else if (line_[0] != '#') {
         field();
-        if (dataFiles_ == kList) return finish(next, /*blankLine=*/false);
+        if (dataFiles_ == kList) {
+          if (!listedNames(next, whole)) return std::nullopt;
+          return finish(next, /*blankLine=*/false);
+        }
       }
       pos = next;
     }
@@ -265,6 +269,45 @@ class Parser {
     }
   }
 
+  /// "data file: LIST [<subdim>]": the names of the data files follow, one a line, up to an
+  /// empty line or the end of the file, as teem reads them (_nrrdReadNrrdParse_data_file); one
+  /// file per <subdim>-dimensional block (dimension - 1 by default). A name with a control byte
+  /// made teem's messages read past their buffer (found by fuzz/); a count other than the
+  /// blocks' is teem's error. False if the head ends before the list and the file is longer;
+  /// the names go to listed_.
+  bool listedNames(std::size_t pos, bool whole) {
+    const std::string_view after = trim(value_.substr(4));
+    int subdim = dimension_ - 1;
+    if (!after.empty()) {
+      const auto n = text::toInteger(after);
+      if (!n || *n < 1 || *n > dimension_) fail("has " + quote(after) + " where a data file dimension in [1, dimension] is expected");
+      subdim = int(*n);
+    }
+    if (!seen_[kSizes]) fail("comes before 'sizes'");
+    std::int64_t files = 1;  // (at most one a line of the header's 1 MiB)
+    for (int a = subdim; a < dimension_; ++a) {
+      if (sizes_[std::size_t(a)] > std::int64_t(kMaxHeaderBytes) / files) fail("needs more listed files than its header can hold");
+      files *= sizes_[std::size_t(a)];
+    }
+    listed_.clear();
+    for (;;) {
+      std::size_t end = pos;
+      while (end < head_.size() && head_[end] != '\n' && head_[end] != '\r') ++end;
+      if (end >= head_.size() && !whole) return false;
+      const std::string_view name = head_.substr(pos, end - pos);
+      if (name.empty()) break;
+      for (char c : name)
+        if (text::isControl(c)) fail("lists a data file name with a control character");
+      listed_.emplace_back(name);
+      if (end >= head_.size()) break;
+      pos = end + 1;
+      if (head_[end] == '\r' && pos < head_.size() && head_[pos] == '\n') ++pos;
+    }
+    if (std::int64_t(listed_.size()) != files)
+      fail("lists " + std::to_string(listed_.size()) + " data files, and the image needs " + std::to_string(files));
+    return true;
+  }
+
   /// teem's test for numbered data files: the first '%' that is not "%%" is "%<digits>d"
   /// (any other name, '%' or not, is one file).
   static bool isFilePattern(std::string_view s) {
@@ -376,6 +419,9 @@ class Parser {
     else if (encoding_ == kText) layout.maxExpansion = double(bytesPerVoxel) / 2;
     if (seen_[kDataFile]) {
       layout.severalDataFiles = dataFiles_ != kOne;
+      layout.listedFiles = listed_;
+      if (!listed_.empty() && encoding_ == kRaw && byteSkip_ >= 0 && lineSkip_ == 0)
+        layout.listedPartBytes = layout.dataBytes() / listed_.size() + std::uint64_t(byteSkip_);
       if (dataFiles_ != kOne) because("its voxels are in several files ('data file: " + std::string(dataFile_) + "')");
       layout.dataFile = std::string(dataFile_);
       layout.fromEnd = byteSkip_ == -1;
@@ -408,6 +454,7 @@ class Parser {
   bool bigEndian_ = false;
   std::int64_t byteSkip_ = 0, lineSkip_ = 0;
   enum { kOne, kList, kNumbered } dataFiles_ = kOne;
+  std::vector<std::string> listed_;
 };
 
 }  // namespace

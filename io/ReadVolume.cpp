@@ -8,7 +8,9 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <cstdlib>
 #include <fstream>
+#include <iostream>
 #include <mutex>
 #include <regex>
 #include <sstream>
@@ -34,10 +36,19 @@
 #include <itkVTKImageIOFactory.h>
 #include <zlib.h>
 
+#include <cstdarg>
+
 #include "Internal.h"
 #include "MappedFile.h"
 #include "TiffStack.h"
 #include "VolumeHeader.h"
+
+// ITK's own copy of libtiff (libitktiff, every name prefixed itk_; its header is not
+// installed): libtiff's TIFFSetWarningHandler.
+extern "C" {
+using ItkTiffHandler = void (*)(const char* module, const char* format, va_list arguments);
+ItkTiffHandler itk_TIFFSetWarningHandler(ItkTiffHandler handler);
+}
 
 namespace surftrack::io {
 
@@ -52,6 +63,8 @@ void registerFactories() {
   static std::once_flag once;
   std::call_once(once, [] {
     itk::Object::GlobalWarningDisplayOff();  // ITK warnings are multi-line noise on stderr
+    itk_TIFFSetWarningHandler(nullptr);       // and libtiff's (ITK's TIFF reader installs an
+                                              // error handler of its own, not a warning one)
     gdcm::Trace::WarningOff();                // and so are GDCM's (DICOM)
     gdcm::Trace::ErrorOff();
     gdcm::Trace::DebugOff();
@@ -63,6 +76,21 @@ void registerFactories() {
     itk::VTKImageIOFactory::RegisterOneFactory();
   });
 }
+
+/// Mutes std::cerr for its lifetime: ITK's MetaIO and NRRD readers write their complaints there
+/// ("MetaImage: M_ReadElementsData: file stream is fail after read") before the exception that
+/// reaches the user as one ReadError line. Process-wide while ITK reads: another thread's output
+/// on std::cerr in that time is lost too (the tool reads its one file before it starts threads).
+class MutedCerr {
+ public:
+  MutedCerr() : saved_(std::cerr.rdbuf(nullptr)) {}
+  ~MutedCerr() { std::cerr.rdbuf(saved_); }  // (rdbuf() clears the error state muting set)
+  MutedCerr(const MutedCerr&) = delete;
+  MutedCerr& operator=(const MutedCerr&) = delete;
+
+ private:
+  std::streambuf* saved_;
+};
 
 /// An ITK exception as one line for a user: its description with white space collapsed,
 /// without ITK's "ITK ERROR: NrrdImageIO(0x55e4aa74c3b0): " (a pointer tells a user nothing;
@@ -434,6 +462,35 @@ std::string formatOf(const itk::ImageIOBase* imageIO, const std::string& path) {
   return ext.size() > 1 ? ext.substr(1) : io;
 }
 
+/// The name ITK's NIfTI reader should read the voxels of `path` from. niftilib looks for the
+/// voxels of X.nii.gz by base name, X.nii first: when that file exists beside it, ITK gives the
+/// header of X.nii.gz with the voxels of X.nii. Such a file is read through a link of its own in
+/// an empty directory, removed with this object; any other file by its own name.
+class SoleName {
+ public:
+  explicit SoleName(const std::string& path) : path_(path) {
+    const std::string name = lowerName(path);
+    std::error_code ec;
+    if (!endsWith(name, ".nii.gz") || !fs::exists(path.substr(0, path.size() - 3), ec)) return;
+    std::string dir = (fs::temp_directory_path() / "surftrack-nifti-XXXXXX").string();
+    if (!::mkdtemp(dir.data())) throw ReadError("cannot read '" + path + "': " + std::strerror(errno));
+    dir_ = dir;
+    path_ = (fs::path(dir) / "volume.nii.gz").string();
+    fs::create_symlink(fs::absolute(path), path_, ec);
+    if (ec) throw ReadError("cannot read '" + path + "': " + ec.message());
+  }
+  ~SoleName() {
+    std::error_code ec;
+    if (!dir_.empty()) fs::remove_all(dir_, ec);
+  }
+  SoleName(const SoleName&) = delete;
+  SoleName& operator=(const SoleName&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_, dir_;
+};
+
 /// The ImageJ or OME metadata of the TIFF `path` (io/TiffStack.h).
 TiffStack tiffStackOf(const std::string& path) {
   const detail::OpenFile file(path, "cannot read '" + path + "'");
@@ -497,6 +554,7 @@ auto readWithItk(const std::string& path, const ReadOptions& options, Use&& use)
   registerFactories();
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
+  const MutedCerr muted;
   try {
     if (fs::is_directory(path, ec)) {
       detail::requireChannel(path, options, 1, "");
@@ -513,9 +571,10 @@ auto readWithItk(const std::string& path, const ReadOptions& options, Use&& use)
     read.unit = stack.unit;
     read.channels = int(stack.channels);
     read.channel = detail::requireChannel(path, options, stack.channels, stack.channelsField);
+    const SoleName sole(path);
     return visitScalarType(type, [&](auto v) {
       using T = decltype(v);
-      ImagePointer<T> image = readFileAs<T>(imageIO, path);
+      ImagePointer<T> image = readFileAs<T>(imageIO, sole.path());
       if (!stack.source.empty()) image = stackChannel<T>(image, stack, read.channel, path);
       return use(image, read);
     });
@@ -566,6 +625,7 @@ ItkHeader readItkHeader(const std::string& path) {
   registerFactories();
   std::error_code ec;
   if (!fs::exists(path, ec)) throw ReadError("cannot read '" + path + "': no such file");
+  const MutedCerr muted;
   try {
     ItkHeader header;
     std::size_t voxels = 0;

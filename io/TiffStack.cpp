@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <unordered_set>
 #include <vector>
 
 #include "HeaderText.h"
@@ -22,11 +23,22 @@ constexpr std::uint64_t kMaxDescription = std::uint64_t(16) << 20;
 
 constexpr int kImageDescription = 270, kXResolution = 282, kYResolution = 283;
 
-/// The tags of the first page that matter here.
+/// What a page says about its voxels; ITK's TIFF reader reads every page as the first one
+/// (its buffer and its scanlines sized by it).
+struct PageShape {
+  std::uint64_t width = 0, length = 0, bits = 1, samples = 1, format = 1, planar = 1;  // (TIFF 6.0's defaults)
+  bool operator==(const PageShape&) const = default;
+};
+
+/// The tags of the first page that matter here, and the number of pages.
 struct FirstPage {
   std::string description;
   std::optional<double> xResolution, yResolution;  ///< pixels per unit
+  std::int64_t pages = 0;
 };
+
+/// The most pages read: beyond, a TIFF is refused rather than walked for ever.
+constexpr std::int64_t kMaxPages = std::int64_t(1) << 20;
 
 /// Integers of the file's byte order.
 class Bytes {
@@ -63,7 +75,16 @@ std::string readExactly(const ReadAt& read, std::uint64_t offset, std::size_t by
   return out;
 }
 
-FirstPage readFirstPage(const ReadAt& read, std::uint64_t fileSize) {
+/// "3 x 4 pixels, 1 sample of 8 bits (format 1, planar 1)": a page's shape for messages.
+std::string shapeText(const PageShape& p) {
+  return std::to_string(p.width) + " x " + std::to_string(p.length) + " pixels, " + std::to_string(p.samples) +
+         " sample of " + std::to_string(p.bits) + " bits (format " + std::to_string(p.format) + ", planar " +
+         std::to_string(p.planar) + ")";
+}
+
+/// Every page directory of the TIFF (TIFF 6.0, and BigTIFF): the first page's description and
+/// resolution, and that every page has the first's shape.
+FirstPage readPages(const ReadAt& read, std::uint64_t fileSize) {
   const std::string head = read(0, 16);
   if (head.size() < 8 || !(head.compare(0, 2, "II") == 0 || head.compare(0, 2, "MM") == 0))
     throw HeaderError("not a TIFF file: it does not begin with 'II' or 'MM'");
@@ -73,44 +94,68 @@ FirstPage readFirstPage(const ReadAt& read, std::uint64_t fileSize) {
   const bool big = magic == 43;  // BigTIFF: 8-byte counts and offsets
   if (big && (head.size() < 16 || b.get(head, 4, 2) != 8))
     throw HeaderError("malformed BigTIFF header (truncated file?)");
-  const std::uint64_t ifd = big ? b.get(head, 8, 8) : b.get(head, 4, 4);
   const std::size_t countBytes = big ? 8 : 2, entryBytes = big ? 20 : 12, valueBytes = big ? 8 : 4;
-  if (ifd < 8 || ifd > fileSize || fileSize - ifd < countBytes)
-    throw HeaderError("the TIFF's first page directory at byte " + std::to_string(ifd) + " is outside the file of " +
-                      std::to_string(fileSize) + " bytes (truncated file?)");
-  const std::uint64_t entries = b.get(readExactly(read, ifd, countBytes), 0, countBytes);
-  if (entries > 65535) throw HeaderError("the TIFF's first page has " + std::to_string(entries) + " tags, more than 65535");
-  if (entries > (fileSize - ifd - countBytes) / entryBytes)
-    throw HeaderError("the TIFF's first page directory runs past the end of the file (truncated file?)");
-  const std::string table = readExactly(read, ifd + countBytes, std::size_t(entries * entryBytes));
   FirstPage page;
-  for (std::uint64_t e = 0; e < entries; ++e) {
-    const std::size_t at = std::size_t(e * entryBytes);
-    const std::uint64_t tag = b.get(table, at, 2), type = b.get(table, at + 2, 2);
-    if (tag != kImageDescription && tag != kXResolution && tag != kYResolution) continue;
-    const std::uint64_t count = big ? b.get(table, at + 4, 8) : b.get(table, at + 4, 4);
-    const std::uint64_t size = typeSize(type);
-    const bool resolution = tag != kImageDescription;
-    if ((resolution && (type != 5 || count != 1)) || (!resolution && type != 2 && type != 7))
-      continue;  // (not of the type TIFF 6.0 gives these tags: ignored, as libtiff does)
-    if (count > kMaxDescription) throw HeaderError("the TIFF's ImageDescription is longer than 16 MiB");
-    const std::uint64_t bytes = size * count;
-    const std::size_t valueAt = at + 4 + (big ? 8 : 4);  // (after the tag, type and count)
-    std::string value;
-    if (bytes <= valueBytes) {
-      value = table.substr(valueAt, std::size_t(bytes));
-    } else {
-      const std::uint64_t offset = b.get(table, valueAt, valueBytes);
-      if (offset > fileSize || fileSize - offset < bytes)
-        throw HeaderError("the TIFF's tag " + std::to_string(tag) + " lies outside the file (truncated file?)");
-      value = readExactly(read, offset, std::size_t(bytes));
+  PageShape first;
+  std::unordered_set<std::uint64_t> seen;
+  for (std::uint64_t ifd = big ? b.get(head, 8, 8) : b.get(head, 4, 4); ifd != 0;) {
+    const std::string which = page.pages == 0 ? "first page" : "page " + std::to_string(page.pages + 1);
+    if (page.pages == kMaxPages) throw HeaderError("the TIFF has more than 2^20 pages");
+    if (ifd < 8 || ifd > fileSize || fileSize - ifd < countBytes + valueBytes)
+      throw HeaderError("the TIFF's " + which + " directory at byte " + std::to_string(ifd) + " is outside the file of " +
+                        std::to_string(fileSize) + " bytes (truncated file?)");
+    const std::uint64_t entries = b.get(readExactly(read, ifd, countBytes), 0, countBytes);
+    if (entries > 65535) throw HeaderError("the TIFF's " + which + " has " + std::to_string(entries) + " tags, more than 65535");
+    if (entries > (fileSize - ifd - countBytes - valueBytes) / entryBytes)
+      throw HeaderError("the TIFF's " + which + " directory runs past the end of the file (truncated file?)");
+    // The directory and the offset of the next one after it.
+    const std::string table = readExactly(read, ifd + countBytes, std::size_t(entries * entryBytes) + valueBytes);
+    PageShape shape;
+    for (std::uint64_t e = 0; e < entries; ++e) {
+      const std::size_t at = std::size_t(e * entryBytes);
+      const std::uint64_t tag = b.get(table, at, 2), type = b.get(table, at + 2, 2);
+      const std::uint64_t count = big ? b.get(table, at + 4, 8) : b.get(table, at + 4, 4);
+      const std::uint64_t size = typeSize(type);
+      const std::size_t valueAt = at + 4 + (big ? 8 : 4);  // (after the tag, type and count)
+      // The first `n` bytes of the tag's values: in the entry, or at the offset it holds.
+      auto value = [&](std::uint64_t n) {
+        if (size * count <= valueBytes) return table.substr(valueAt, std::size_t(n));
+        const std::uint64_t offset = b.get(table, valueAt, valueBytes);
+        if (offset > fileSize || fileSize - offset < size * count)
+          throw HeaderError("the TIFF's tag " + std::to_string(tag) + " lies outside the file (truncated file?)");
+        return readExactly(read, offset, std::size_t(n));
+      };
+      std::uint64_t* field = tag == 256 ? &shape.width : tag == 257 ? &shape.length : tag == 258 ? &shape.bits
+                           : tag == 277 ? &shape.samples : tag == 339 ? &shape.format : tag == 284 ? &shape.planar
+                                                                                        : nullptr;
+      if (field && count >= 1 && (type == 3 || type == 4 || type == 16)) {
+        *field = b.get(value(size), 0, std::size_t(size));
+        continue;
+      }
+      if (page.pages > 0 || (tag != kImageDescription && tag != kXResolution && tag != kYResolution)) continue;
+      const bool resolution = tag != kImageDescription;
+      if ((resolution && (type != 5 || count != 1)) || (!resolution && type != 2 && type != 7))
+        continue;  // (not of the type TIFF 6.0 gives these tags: ignored, as libtiff does)
+      if (count > kMaxDescription) throw HeaderError("the TIFF's ImageDescription is longer than 16 MiB");
+      const std::string bytes = value(size * count);
+      if (resolution) {
+        const double num = double(b.get(bytes, 0, 4)), den = double(b.get(bytes, 4, 4));
+        if (num > 0 && den > 0) (tag == kXResolution ? page.xResolution : page.yResolution) = num / den;
+      } else {
+        page.description = bytes.substr(0, bytes.find('\0'));
+      }
     }
-    if (resolution) {
-      const double num = double(b.get(value, 0, 4)), den = double(b.get(value, 4, 4));
-      if (num > 0 && den > 0) (tag == kXResolution ? page.xResolution : page.yResolution) = num / den;
-    } else {
-      page.description = value.substr(0, value.find('\0'));
+    if (page.pages == 0) {
+      first = shape;
+      if (first.width == 0 || first.length == 0) throw HeaderError("the TIFF's first page has no width or length");
+    } else if (!(shape == first)) {
+      throw HeaderError("its " + which + " (" + shapeText(shape) + ") differs from its first (" + shapeText(first) +
+                        "): ITK reads every page as the first");
     }
+    ++page.pages;
+    seen.insert(ifd);
+    ifd = b.get(table, std::size_t(entries * entryBytes), valueBytes);
+    if (seen.count(ifd) != 0) throw HeaderError("the TIFF's page directories form a loop");
   }
   return page;
 }
@@ -366,7 +411,7 @@ TiffStack omeStack(const FirstPage& page, std::string_view fileName) {
 }  // namespace
 
 TiffStack parseTiffStack(const ReadAt& read, std::uint64_t fileSize, std::string_view fileName) {
-  const FirstPage page = readFirstPage(read, fileSize);
+  const FirstPage page = readPages(read, fileSize);
   const std::string_view d = trim(page.description);
   if (d.substr(0, 7) == "ImageJ=") return imageJStack(page);
   if ((d.substr(0, 5) == "<?xml" || d.substr(0, 4) == "<OME") && d.find("<OME") != std::string_view::npos)

@@ -46,9 +46,12 @@ struct DataLayout {
   /// The voxels are in several files (a list, or numbered files): dataFile is the header's
   /// description of them, not a file name.
   bool severalDataFiles = false;
-  /// MetaImage ElementDataFile = LIST: the listed files, as the header writes them (relative
-  /// to the header's directory unless absolute), each holding an equal part of the voxels.
+  /// MetaImage "ElementDataFile = LIST", NRRD "data file: LIST": the listed files, as the
+  /// header writes them (relative to the header's directory unless absolute), each holding an
+  /// equal part of the voxels,
   std::vector<std::string> listedFiles;
+  /// of at least this many bytes each when they are stored raw (0: not known).
+  std::uint64_t listedPartBytes = 0;
   /// For voxels that are not stored raw: at most this many bytes of voxels per stored byte
   /// (deflate expands at most 1032 times; text needs two characters a value), so that a header
   /// announcing more voxels than its data can hold is an error before a reader allocates

@@ -550,7 +550,11 @@ TEST(LoadVolume, NumberedAndListedDataFilesAreDecodedByItk) {
   // A MetaImage list whose last name ends the file without its newline (MetaIO reads it).
   const std::string metaList = dir / "list.mhd";
   writeFile(metaList, metaHeader("MET_USHORT", kDims, "", "LIST") + "slice1.raw\nslice2.raw\nslice3.raw");
-  for (const std::string& path : {mhd, nhdr, list, metaList}) {
+  // A NRRD list of one file holding all three dimensions, with "\r\n" line ends.
+  writeFile(dir / "all.raw", all);
+  const std::string wholeList = dir / "list3.nhdr";
+  writeFile(wholeList, nrrdHeader("uint16", kDims, "endian: little\nencoding: raw\ndata file: LIST 3\r\n") + "all.raw\r\n");
+  for (const std::string& path : {mhd, nhdr, list, metaList, wholeList}) {
     const LoadedVolume loaded = io::loadVolume(path);
     EXPECT_FALSE(loaded.mapped) << path;
     EXPECT_NE(loaded.decodeReason.find("files"), std::string::npos) << loaded.decodeReason;
@@ -729,6 +733,55 @@ TEST(LoadVolume, DamagedGzippedNiftiIsAReadError) {
   }
 }
 
+/// The bytes a gzip stream inflates to (zlib).
+std::string gunzipped(const std::string& bytes) {
+  z_stream z{};
+  EXPECT_EQ(inflateInit2(&z, 16 + MAX_WBITS), Z_OK);
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+  z.avail_in = uInt(bytes.size());
+  std::string out;
+  char buffer[4096];
+  int status = Z_OK;
+  while (status == Z_OK) {
+    z.next_out = reinterpret_cast<Bytef*>(buffer);
+    z.avail_out = sizeof buffer;
+    status = inflate(&z, Z_NO_FLUSH);
+    out.append(buffer, sizeof buffer - z.avail_out);
+  }
+  EXPECT_EQ(status, Z_STREAM_END);
+  inflateEnd(&z);
+  return out;
+}
+
+/// A .nii.gz beside a .nii of the same base name: niftilib looks for the voxels by base name,
+/// .nii first, and ITK read the header of the one and the voxels of the other. Both readers give
+/// the .nii.gz's own voxels, also when ITK decodes them (scaled voxels).
+TEST(LoadVolume, GzippedNiftiBesideAnUncompressedOneReadsItsOwnVoxels) {
+  TempDir dir;
+  const DenseImage<std::int16_t> image = makeVolume<std::int16_t>(kDims);
+  DenseImage<std::int16_t> other = image;
+  for (auto& v : other.data()) v = std::int16_t(v ^ 0x5a5a);
+  io::writeVolume(io::AnyVolume(other), dir / "scan.nii");
+  for (const bool scaled : {false, true}) {
+    SCOPED_TRACE(scaled ? "scaled" : "plain");
+    const std::string path = dir / "scan.nii.gz";
+    io::writeVolume(io::AnyVolume(image), path);
+    if (scaled) {  // scl_slope 2, inflated, patched, gzipped again
+      std::string bytes = gunzipped(contents(path));
+      const float slope = 2;
+      std::memcpy(&bytes[112], &slope, 4);
+      writeFile(path, gzipped(bytes));
+    }
+    const io::AnyVolume read = io::readVolume(path);
+    const LoadedVolume loaded = io::loadVolume(path);
+    expectSame(loaded, read, path);
+    std::visit([&](const auto& v) {
+      for (std::size_t i = 0; i < image.data().size(); ++i)
+        ASSERT_EQ(double(v.data()[i]), double(image.data()[i]) * (scaled ? 2 : 1)) << i;
+    }, read);
+  }
+}
+
 TEST(LoadVolume, MetaImageValuesAfterExtraSeparators) {
   // MetaIO skips '=', ':' and blanks before a value: "ElementDataFile = = LOCAL" is LOCAL.
   TempDir dir;
@@ -867,6 +920,18 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
       // (std::out_of_range, found by fuzz/).
       {"cutlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nok.raw", "lists 2 data files"},
       {"cutlist1.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ab", "lists 1 data files"},
+      // Three spaces in a row, which MetaIO counts as two words and then reads a word it never
+      // wrote (a crash under fuzz/).
+      {"spaces.mhd", metaHeader("MET_SHORT", kDims, "", "slice%d.raw   1 3 1"), "three or more spaces"},
+      {"spacedlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST   2") + "ok.raw\nok.raw\nok.raw\n", "three or more spaces"},
+      // NRRD lists of data files as teem reads them: the count of blocks, names without a
+      // control byte (a NUL made teem's messages read past their buffer, under fuzz/).
+      {"nullist.nhdr", okNrrd + "data file: LIST\nok.raw\n" + std::string("o\0k.raw\n", 8) + "ok.raw\n", "control character"},
+      {"shortlist.nhdr", okNrrd + "data file: LIST\nok.raw\nok.raw\n", "lists 2 data files, and the image needs 3"},
+      {"blanklist.nhdr", okNrrd + "data file: LIST\nok.raw\n\nok.raw\nok.raw\n", "lists 1 data files"},
+      {"listdim.nhdr", okNrrd + "data file: LIST 4\nok.raw\n", "data file dimension"},
+      {"missinglist.nhdr", okNrrd + "data file: LIST\nok.raw\nnowhere.raw\nok.raw\n", "no such file"},
+      {"tinylist.nhdr", okNrrd + "data file: LIST\nok.raw\ntiny.raw\nok.raw\n", "truncated"},
       // ITK's matrix code aborts on the infinity 1e200 * 1e200 makes.
       {"huge.mha", "ObjectType = Image\nNDims = 3\nDimSize = 7 5 3\nElementSpacing = 1e200 1e200 1e200\n"
                    "TransformMatrix = 1e200 0 0 0 1e200 0 0 0 1e200\nElementType = MET_SHORT\nElementDataFile = LOCAL\n" + data,
@@ -1001,7 +1066,14 @@ TEST(LoadVolume, ItkErrorsAreOneLineWithoutPointers) {
   const std::int16_t badType = 1;  // DT_BINARY: niftilib's "bad datatype"
   std::memcpy(&bytes[70], &badType, 2);
   writeFile(nifti, bytes);
-  for (const std::string& path : {cut, nifti}) {
+  std::vector<std::string> paths = {cut, nifti};
+#ifdef SURFTRACK_FUZZ_DIR
+  // A TIFF whose pages differ (ITK's reader overflowed its buffer on it), with tags out of
+  // order: libtiff warned on stderr as ITK opened it.
+  paths.push_back(dir / "pages.tif");
+  writeFile(paths.back(), contents(SURFTRACK_FUZZ_DIR "/findings/tif/pages-unlike-the-first-itk-overflow.tif"));
+#endif
+  for (const std::string& path : paths) {
     SCOPED_TRACE(path);
     testing::internal::CaptureStderr();
     std::string message;
