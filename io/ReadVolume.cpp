@@ -415,15 +415,36 @@ void requireCompleteData(itk::ImageIOBase* imageIO, const std::string& path, std
   }
 }
 
+TiffStack tiffStackOf(const std::string& path);
+
+/// Whether `path` begins as a TIFF or BigTIFF does ("II*\0", "MM\0*", "II+\0", "MM\0+"), as
+/// libtiff, and so ITK's TIFF reader, recognises one.
+bool isTiff(const std::string& path) {
+  char head[4] = {};
+  std::ifstream in(path, std::ios::binary);
+  if (!in.read(head, 4)) return false;
+  const std::string_view h(head, 4);
+  return h == std::string_view("II*\0", 4) || h == std::string_view("MM\0*", 4) || h == std::string_view("II+\0", 4) ||
+         h == std::string_view("MM\0+", 4);
+}
+
 /// The ImageIO that reads the file `path`, after readVolume's checks (an existing, readable,
 /// non-empty file ITK recognises, a 3D image of one scalar component per voxel), its header read;
-/// `type` and `voxels` are the voxel type and count.
-itk::ImageIOBase::Pointer openImageIO(const std::string& path, ScalarType& type, std::size_t& voxels) {
+/// `type` and `voxels` are the voxel type and count, `stack` what a TIFF's metadata says.
+itk::ImageIOBase::Pointer openImageIO(const std::string& path, ScalarType& type, std::size_t& voxels,
+                                      TiffStack* stack = nullptr) {
   std::error_code ec;
   {
     std::ifstream probe(path, std::ios::binary);
     if (!probe) throw ReadError("cannot open '" + path + "': " + std::strerror(errno));
     if (fs::file_size(path, ec) == 0) throw ReadError("cannot read '" + path + "': the file is empty");
+  }
+  // A TIFF's directories are read by io/TiffStack.cpp before ITK opens it: it refuses what
+  // libtiff would allocate without bound as ITK probes the file (CreateImageIO) and the tags
+  // ITK's reader would read past (ReadImageInformation copies every tag into its dictionary).
+  if (isTiff(path)) {
+    TiffStack parsed = tiffStackOf(path);
+    if (stack) *stack = std::move(parsed);
   }
   itk::ImageIOBase::Pointer imageIO =
       itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::IOFileModeEnum::ReadMode);
@@ -432,6 +453,8 @@ itk::ImageIOBase::Pointer openImageIO(const std::string& path, ScalarType& type,
                     "': not a recognised image file (NIfTI, NRRD, MetaImage, DICOM, TIFF, VTK); "
                     "for a raw file give --raw-dims and --raw-type");
   imageIO->SetFileName(path);
+  if (std::string(imageIO->GetNameOfClass()) == "TIFFImageIO" && !isTiff(path))
+    throw ReadError("cannot read '" + path + "': ITK reads it as a TIFF, and it does not begin as one");
   imageIO->ReadImageInformation();
   const unsigned dimension = imageIO->GetNumberOfDimensions();
   voxels = 1;
@@ -562,12 +585,11 @@ auto readWithItk(const std::string& path, const ReadOptions& options, Use&& use)
     }
     ScalarType type{};
     std::size_t voxels = 0;
-    itk::ImageIOBase::Pointer imageIO = openImageIO(path, type, voxels);
+    TiffStack stack;
+    itk::ImageIOBase::Pointer imageIO = openImageIO(path, type, voxels, &stack);
     requireCompleteData(imageIO, path, voxels);
     ItkRead read;
     read.format = formatOf(imageIO, path);
-    TiffStack stack;
-    if (read.format == "tiff") stack = tiffStackOf(path);
     read.unit = stack.unit;
     read.channels = int(stack.channels);
     read.channel = detail::requireChannel(path, options, stack.channels, stack.channelsField);

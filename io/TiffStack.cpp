@@ -22,6 +22,11 @@ using text::trim;
 constexpr std::uint64_t kMaxDescription = std::uint64_t(16) << 20;
 
 constexpr int kImageDescription = 270, kXResolution = 282, kYResolution = 283;
+/// DateTime: TIFF 6.0 gives it 20 bytes ("YYYY:MM:DD HH:MM:SS" and a NUL). libtiff keeps as
+/// many as the file holds, and ITK's TIFF reader copies 20 into its dictionary: a shorter one
+/// would be read past its end, so it is refused.
+constexpr int kDateTime = 306;
+constexpr std::uint64_t kDateTimeBytes = 20;
 
 /// What a page says about its voxels; ITK's TIFF reader reads every page as the first one
 /// (its buffer and its scanlines sized by it).
@@ -29,6 +34,52 @@ struct PageShape {
   std::uint64_t width = 0, length = 0, bits = 1, samples = 1, format = 1, planar = 1;  // (TIFF 6.0's defaults)
   bool operator==(const PageShape&) const = default;
 };
+
+/// Where a page's pixels are: in strips of rowsPerStrip rows, or in tiles when tileWidth is
+/// set; the number of offsets the page lists. libtiff sizes its arrays of offsets by the
+/// number of strips or tiles the image's size implies, whatever the page lists, and cuts one
+/// uncompressed strip into many: the checks below keep both within what the file can hold.
+struct PageLayout {
+  std::uint64_t compression = 1, rowsPerStrip = 0xffffffff, tileWidth = 0, tileLength = 0;
+  std::uint64_t stripOffsets = 0, tileOffsets = 0;
+};
+
+/// ceil(a / b) for b > 0.
+std::uint64_t howMany(std::uint64_t a, std::uint64_t b) { return a / b + (a % b != 0); }
+
+/// Refuses a page whose strips or tiles libtiff would allocate beyond the file: fewer offsets
+/// listed than the page's size needs (TIFF 6.0's StripsPerImage, TilesPerImage), or
+/// uncompressed pixels larger than the file.
+void requireLayoutInFile(const PageShape& shape, const PageLayout& layout, std::uint64_t fileSize,
+                         const std::string& which) {
+  const std::uint64_t planes = shape.planar == 2 ? shape.samples : 1;
+  std::uint64_t needed = 0, listed = 0;
+  std::string what;
+  if (layout.tileWidth != 0 || layout.tileLength != 0) {
+    if (layout.tileWidth == 0 || layout.tileLength == 0)
+      throw HeaderError("the TIFF's " + which + " has a tile width or length of 0");
+    needed = howMany(shape.width, layout.tileWidth) * howMany(shape.length, layout.tileLength);
+    listed = layout.tileOffsets;
+    what = "TileOffsets";
+  } else {
+    if (layout.rowsPerStrip == 0) throw HeaderError("the TIFF's " + which + " has RowsPerStrip 0");
+    needed = howMany(shape.length, layout.rowsPerStrip);
+    listed = layout.stripOffsets;
+    what = "StripOffsets";
+  }
+  // (width and length are below 2^32, tiles at least 1 x 1: the products fit in 128 bits)
+  const unsigned __int128 offsets = static_cast<unsigned __int128>(needed) * planes;
+  if (offsets > listed)
+    throw HeaderError("the TIFF's " + which + " lists " + std::to_string(listed) + " " + what + ", fewer than the " +
+                      (offsets > ~std::uint64_t(0) ? std::string("2^64 or more") : std::to_string(std::uint64_t(offsets))) +
+                      " its size of " + std::to_string(shape.width) + " x " + std::to_string(shape.length) +
+                      " pixels needs (truncated or damaged file?)");
+  const unsigned __int128 row = (static_cast<unsigned __int128>(shape.width) * shape.samples * shape.bits + 7) / 8;
+  if (layout.compression == 1 && row * shape.length > fileSize)
+    throw HeaderError("the TIFF's " + which + " holds " + std::to_string(shape.width) + " x " +
+                      std::to_string(shape.length) + " uncompressed pixels, more than its file of " +
+                      std::to_string(fileSize) + " bytes (truncated or damaged file?)");
+}
 
 /// The tags of the first page that matter here, and the number of pages.
 struct FirstPage {
@@ -111,20 +162,41 @@ FirstPage readPages(const ReadAt& read, std::uint64_t fileSize) {
     // The directory and the offset of the next one after it.
     const std::string table = readExactly(read, ifd + countBytes, std::size_t(entries * entryBytes) + valueBytes);
     PageShape shape;
+    PageLayout layout;
+    std::unordered_set<std::uint64_t> tags;
     for (std::uint64_t e = 0; e < entries; ++e) {
       const std::size_t at = std::size_t(e * entryBytes);
       const std::uint64_t tag = b.get(table, at, 2), type = b.get(table, at + 2, 2);
       const std::uint64_t count = big ? b.get(table, at + 4, 8) : b.get(table, at + 4, 4);
       const std::uint64_t size = typeSize(type);
       const std::size_t valueAt = at + 4 + (big ? 8 : 4);  // (after the tag, type and count)
+      if (size == 0 || !tags.insert(tag).second) continue;  // (unknown types and repeated tags: libtiff ignores them)
+      // Every tag's values lie in the file: libtiff allocates them by their count before it reads.
+      if (count > fileSize / size ||
+          (size * count > valueBytes && (b.get(table, valueAt, valueBytes) > fileSize - size * count)))
+        throw HeaderError("the TIFF's tag " + std::to_string(tag) + " lies outside the file (truncated file?)");
       // The first `n` bytes of the tag's values: in the entry, or at the offset it holds.
       auto value = [&](std::uint64_t n) {
         if (size * count <= valueBytes) return table.substr(valueAt, std::size_t(n));
-        const std::uint64_t offset = b.get(table, valueAt, valueBytes);
-        if (offset > fileSize || fileSize - offset < size * count)
-          throw HeaderError("the TIFF's tag " + std::to_string(tag) + " lies outside the file (truncated file?)");
-        return readExactly(read, offset, std::size_t(n));
+        return readExactly(read, b.get(table, valueAt, valueBytes), std::size_t(n));
       };
+      // An ASCII value's count includes its NUL (TIFF 6.0): libtiff keeps an unknown tag's bytes
+      // as they are, and ITK's reader takes a value of one byte for a NUL-terminated string.
+      if (type == 2 && (count == 0 || (count == 1 && table[valueAt] != '\0')))
+        throw HeaderError("the TIFF's tag " + std::to_string(tag) + " holds text without its NUL (" +
+                          std::to_string(count) + (count == 1 ? " byte)" : " bytes)"));
+      if (tag == kDateTime && type == 2 && count < kDateTimeBytes)
+        throw HeaderError("the TIFF's DateTime tag holds " + std::to_string(count) + " bytes, not the 20 of TIFF 6.0");
+      if (tag == 273 || tag == 324) {
+        (tag == 273 ? layout.stripOffsets : layout.tileOffsets) = count;
+        continue;
+      }
+      std::uint64_t* place = tag == 259 ? &layout.compression : tag == 278 ? &layout.rowsPerStrip
+                           : tag == 322 ? &layout.tileWidth : tag == 323 ? &layout.tileLength : nullptr;
+      if (place && count >= 1 && (type == 3 || type == 4 || type == 16)) {
+        *place = b.get(value(size), 0, std::size_t(size));
+        continue;
+      }
       std::uint64_t* field = tag == 256 ? &shape.width : tag == 257 ? &shape.length : tag == 258 ? &shape.bits
                            : tag == 277 ? &shape.samples : tag == 339 ? &shape.format : tag == 284 ? &shape.planar
                                                                                         : nullptr;
@@ -145,6 +217,7 @@ FirstPage readPages(const ReadAt& read, std::uint64_t fileSize) {
         page.description = bytes.substr(0, bytes.find('\0'));
       }
     }
+    requireLayoutInFile(shape, layout, fileSize, which);
     if (page.pages == 0) {
       first = shape;
       if (first.width == 0 || first.length == 0) throw HeaderError("the TIFF's first page has no width or length");

@@ -119,4 +119,18 @@ def test_what_surftrack_cannot_read_is_refused(tmp_path, data):
     rgb = tmp_path / "rgb.ome.tif"
     tifffile.imwrite(rgb, np.zeros((4, 16, 16, 3), np.uint8), ome=True, photometric="rgb",
                      metadata={"axes": "ZYXS"})
-    expect_refused(rgb, says=["3 components"])
+    expect_refused(rgb, says=["3 samples per pixel"])
+
+
+def test_a_date_time_shorter_than_tiff_6_is_refused(tmp_path, data):
+    """ITK's TIFF reader copies DateTime's 20 bytes (TIFF 6.0) whatever the file holds: a
+    shorter one is refused before ITK reads past it, a well-formed one read as usual."""
+    one = data[:, 0]
+    good = tmp_path / "dated.tif"
+    tifffile.imwrite(good, one, datetime="2026:12:03 10:00:00")
+    code, report, err = info(good)
+    assert code == 0, err
+    expect_voxels(report, one)
+    short = tmp_path / "short-date.tif"
+    tifffile.imwrite(short, one, extratags=[(306, "s", 0, "2026:12:03", True)])  # DateTime, 11 bytes
+    expect_refused(short, says=["DateTime", "11 bytes", "not the 20"])
