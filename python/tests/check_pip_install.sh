@@ -3,12 +3,14 @@
 # that sees Debian's numpy, `pip install --no-build-isolation` from the checkout, then an import
 # and one extraction from outside the source tree.
 set -euo pipefail
-python=$1 source=$2 work=$3
+python=$1 source=$2 work=$3 build=$4
 rm -rf "$work" && mkdir -p "$work"
 "$python" -m venv --system-site-packages "$work/venv"
 # A copy of the checkout, so that the build writes nothing into the source tree.
 tar -C "$source" --exclude=./build --exclude=./.git -cf - . | (mkdir -p "$work/src" && tar -C "$work/src" -xf -)
-"$work/venv/bin/pip" install --no-build-isolation --no-deps --no-index -q "$work/src"
+# The module comes from the build that runs this test (SURFTRACK_BUILD_DIR, setup.py): the
+# project is not compiled a second time; what is checked is the install path around it.
+SURFTRACK_BUILD_DIR=$build "$work/venv/bin/pip" install --no-build-isolation --no-deps --no-index -q "$work/src"
 cd "$work"
 "$work/venv/bin/python" - <<'PY'
 import importlib.metadata
