@@ -17,7 +17,8 @@ import numpy as np
 from . import _surftrack
 from ._surftrack import Cancelled, InternalError, InvalidInput
 
-__all__ = ["extract", "label_surfaces", "marching_cubes", "Surface", "InvalidInput", "InternalError", "Cancelled"]
+__all__ = ["extract", "label_surfaces", "marching_cubes", "Mesher", "Mesh", "Surface", "InvalidInput",
+           "InternalError", "Cancelled"]
 
 #: The project's version (CMake's project VERSION, as ``surftrack --version`` prints it).
 __version__ = _surftrack.__version__
@@ -398,3 +399,6 @@ def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_dire
         faces = faces[:, ::-1].copy()
         normals = -normals
     return verts, faces, normals, values
+
+
+from .mesher import Mesh, Mesher  # noqa: E402  (zmesh's interface over label_surfaces)
