@@ -395,9 +395,12 @@ def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_dire
     values = array[tuple(c.T)].astype(np.float32)
     dv = array[tuple(np.where(inside[:, None], d, c).T)].astype(np.float32)
     values = np.maximum(values, dv)
-    if gradient_direction == "ascent":
-        faces = faces[:, ::-1].copy()
-        normals = -normals
+    # scikit-image's winding: its faces are wound clockwise seen from the side the normals
+    # point to ("descent", the default) or counter-clockwise ("ascent"); its normals point
+    # down the gradient either way, as this engine's do (outwards from the voxels above the
+    # level). The engine winds counter-clockwise seen from outside.
+    if gradient_direction == "descent":
+        faces = np.ascontiguousarray(faces[:, ::-1])
     return verts, faces, normals, values
 
 

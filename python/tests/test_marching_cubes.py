@@ -37,6 +37,13 @@ def closed_oriented_manifold(faces, n_vertices):
     return len(succ) == n_vertices
 
 
+def winding_agrees_with_normals(verts, faces, normals):
+    """Per face: whether its right-hand normal points the way its vertices' normals do."""
+    tri = verts[faces].astype(np.float64)
+    face_n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    return np.sum(face_n * normals[faces].sum(axis=1), axis=1) > 0
+
+
 CASES = [(seed, shape, spacing)
          for seed, (shape, spacing) in enumerate(
              [((12, 13, 14), (1, 1, 1)), ((20, 9, 16), (0.5, 2.0, 1.25)), ((8, 24, 10), (1, 1, 3)),
@@ -71,10 +78,16 @@ def test_vertices_are_lorensens_on_every_inner_grid_edge(seed, shape, spacing):
     assert closed_oriented_manifold(faces, len(verts))
     ours = normals[inner][idx]
     assert np.mean(np.sum(ours * ref_normals, axis=1) > 0) > 0.99
-    # Face orientation agrees with the normals: outward from the voxels above the level.
-    tri = verts[faces]
-    face_n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    assert np.mean(np.sum(face_n * normals[faces].sum(axis=1), axis=1) > 0) > 0.99
+    # Faces wound as scikit-image winds them relative to the normals, for both gradient
+    # directions: its faces read against its own normals give the sign ours must have.
+    for direction in ("descent", "ascent"):
+        v, f, n, _ = surftrack.marching_cubes(volume, level, spacing=spacing, gradient_direction=direction)
+        rv, rf, rn, _ = skimage_measure.marching_cubes(volume, level, spacing=spacing, method="lorensen",
+                                                       gradient_direction=direction)
+        assert np.array_equal(v, verts) and np.array_equal(n, normals)
+        agree = np.mean(winding_agrees_with_normals(v, f, n))
+        ref_agree = np.mean(winding_agrees_with_normals(rv, rf, rn))
+        assert (agree > 0.99 and ref_agree > 0.99) or (agree < 0.01 and ref_agree < 0.01), (direction, agree, ref_agree)
 
 
 def test_refused_and_ignored_arguments():
@@ -89,4 +102,4 @@ def test_refused_and_ignored_arguments():
         surftrack.marching_cubes(volume, method="dual")
     v1, f1, n1, _ = surftrack.marching_cubes(volume, allow_degenerate=False, method="lorensen")
     v2, f2, n2, _ = surftrack.marching_cubes(volume, gradient_direction="ascent")
-    assert np.array_equal(v1, v2) and np.array_equal(f1[:, ::-1], f2) and np.array_equal(n1, -n2)
+    assert np.array_equal(v1, v2) and np.array_equal(f1[:, ::-1], f2) and np.array_equal(n1, n2)
