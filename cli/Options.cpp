@@ -4,6 +4,7 @@
 // after parsing. The help texts are CLI11's, laid out by HelpFormatter.
 #include "Options.h"
 
+#include <filesystem>
 #include <algorithm>
 #include <charconv>
 #include <climits>
@@ -635,6 +636,17 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
                  "boundaries, Euler characteristic, genus, area, volume (physical units)")
       ->option_text("FILE")
       ->group("input and output");
+  app.add_option("--format", o.format, "precomputed: write -o DIR/ as a Neuroglancer precomputed mesh\n"
+                 "directory (legacy format, nanometres; docs/cli.md, \"Neuroglancer output\")")
+      ->option_text("F")
+      ->check(CLI::IsMember({"precomputed"}))
+      ->group("input and output");
+  app.add_option("--unit", o.unit, "the unit of the volume's spacing, for --format precomputed: nm, um,\n"
+                 "mm, cm, m (default: the unit the file states; mm for NIfTI, NRRD,\n"
+                 "MetaImage and DICOM, as ITK reads them)")
+      ->option_text("U")
+      ->check(CLI::IsMember({"nm", "um", "µm", "mm", "cm", "m"}))
+      ->group("input and output");
   const std::string which = "which labels and boundaries";
   app.add_option("--labels", args.labels, "labels 3,17,42 or a range 10-20 (default: every label)")
       ->option_text("LIST")
@@ -751,6 +763,10 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   }
   if (o.largest && !o.seeds.empty()) throw UsageError("give --largest or --seed, not both");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
+  if (!o.unit.empty() && o.format != "precomputed") throw UsageError("--unit is for --format precomputed");
+  if (o.format == "precomputed" && (o.output.find('{') != std::string::npos ||
+                                    (o.output.back() != '/' && !std::filesystem::path(o.output).extension().empty())))
+    throw UsageError("--format precomputed writes a directory: give -o DIR/, not '" + o.output + "'");
   checkRaw(o.input, a.input);
   return o;
 }

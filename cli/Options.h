@@ -107,6 +107,10 @@ struct LabelsOptions {
   int threads = 0;
   bool ascii = false;
   std::string table;  ///< --table FILE.csv | FILE.json
+  /// --format precomputed: -o DIR/ is a Neuroglancer precomputed mesh directory (legacy format)
+  /// instead of one mesh file per label.
+  std::string format;
+  std::string unit;   ///< --unit U: the physical unit of the volume's spacing (precomputed output)
   OutputOptions out;
 };
 

@@ -79,7 +79,7 @@ std::string hiddenTemporaryName(const std::string& name, const std::string& exte
 
 }  // namespace
 
-StagedOutputs StagedOutputs::inDirectory(const std::string& directory) {
+void requireOutputDirectory(const std::string& directory) {
   std::error_code ec;
   fs::path dir(directory);
   if (dir.filename().empty()) dir = dir.parent_path();  // "out/" -> "out"
@@ -89,6 +89,13 @@ StagedOutputs StagedOutputs::inDirectory(const std::string& directory) {
     throw std::runtime_error("cannot write into '" + directory +
                              "': the directory is not empty (a directory of outputs is written whole)");
   requireWritableDirectory((dir.parent_path().empty() ? fs::path(".") : dir.parent_path()).string(), directory);
+}
+
+StagedOutputs StagedOutputs::inDirectory(const std::string& directory) {
+  requireOutputDirectory(directory);
+  fs::path dir(directory);
+  if (dir.filename().empty()) dir = dir.parent_path();
+  std::error_code ec;
   StagedOutputs out;
   out.directory_ = dir.string();
   out.staging_ = (dir.parent_path() / hiddenTemporaryName(dir.filename().string())).string();

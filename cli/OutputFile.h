@@ -23,6 +23,9 @@ void requireWritable(const std::string& path);
 /// is a directory and this process may create files in it (access W_OK | X_OK: no file is
 /// created to find out, so no name in it is reserved).
 void requireWritableDirectory(const std::string& directory, const std::string& what);
+/// A directory of outputs, written whole: `directory` must be absent or empty, its parent
+/// writable. Throws std::runtime_error (one line) otherwise.
+void requireOutputDirectory(const std::string& directory);
 
 /// Throws std::runtime_error (one line) if `output` is the file `input` — the same file by
 /// std::filesystem::equivalent, so also through a symbolic or hard link or another spelling of

@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <cstring>
 #include <chrono>
 #include <future>
 #include <regex>
@@ -19,6 +20,8 @@
 #include <surftrack/Extract.h>
 #include <surftrack/Labels.h>
 #include <surftrack/Refine.h>
+
+#include "PrecomputedMesh.h"  // converter/: Neuroglancer's format
 
 namespace py = pybind11;
 using namespace surftrack;
@@ -446,6 +449,37 @@ void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> 
   runWatchingSignals(cancel, [&] { writeSurface(s, path, binary, &cancel); });
 }
 
+/// Writes (label, vertices, faces, name) tuples as a Neuroglancer precomputed mesh directory
+/// (converter/PrecomputedMesh.h); `linear` and `offset` map the vertices to nanometres.
+void writePrecomputed(const py::list& segments, const std::string& path, std::array<std::array<double, 3>, 3> linear,
+                      std::array<double, 3> offset) {
+  std::vector<std::vector<std::array<double, 3>>> vertices(segments.size());
+  std::vector<std::vector<std::array<std::uint32_t, 3>>> triangles(segments.size());
+  std::vector<PrecomputedSegment> out;
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const py::tuple t = segments[i].cast<py::tuple>();
+    const auto v = t[1].cast<py::array_t<double, py::array::c_style | py::array::forcecast>>();
+    const auto f = t[2].cast<py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>>();
+    if (v.ndim() != 2 || v.shape(1) != 3) throw py::value_error("vertices must be (N, 3)");
+    if (f.ndim() != 2 || f.shape(1) != 3) throw py::value_error("faces must be (M, 3)");
+    vertices[i].resize(std::size_t(v.shape(0)));
+    std::memcpy(vertices[i].data(), v.data(), vertices[i].size() * sizeof(vertices[i][0]));
+    triangles[i].resize(std::size_t(f.shape(0)));
+    const std::int64_t* fp = f.data();
+    for (std::size_t k = 0; k < 3 * triangles[i].size(); ++k) {
+      if (fp[k] < 0 || std::size_t(fp[k]) >= vertices[i].size())
+        throw py::value_error("a face refers to a vertex that does not exist");
+      triangles[i][k / 3][k % 3] = std::uint32_t(fp[k]);
+    }
+    out.push_back({labelOf(t[0], "label"), &vertices[i], &triangles[i], t[3].cast<std::string>()});
+  }
+  try {
+    writePrecomputedMeshes(out, path, ToNanometres{linear, offset});
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_surftrack, m) {
@@ -475,4 +509,5 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("extract_array", &extractArray);
   m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
+  m.def("write_precomputed", &writePrecomputed);
 }

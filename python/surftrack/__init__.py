@@ -17,7 +17,7 @@ import numpy as np
 from . import _surftrack
 from ._surftrack import Cancelled, InternalError, InvalidInput
 
-__all__ = ["extract", "label_surfaces", "marching_cubes", "Mesher", "Mesh", "Surface", "InvalidInput",
+__all__ = ["extract", "label_surfaces", "marching_cubes", "Mesher", "Mesh", "write_precomputed", "Surface", "InvalidInput",
            "InternalError", "Cancelled"]
 
 #: The project's version (CMake's project VERSION, as ``surftrack --version`` prints it).
@@ -405,3 +405,4 @@ def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_dire
 
 
 from .mesher import Mesh, Mesher  # noqa: E402  (zmesh's interface over label_surfaces)
+from .precomputed import write_precomputed  # noqa: E402  (Neuroglancer's format)
