@@ -20,6 +20,12 @@
 // writes it and its point (a boundary mapping, §3.1) and every triangle straight into the
 // arrays the caller allocated from the counts. A slab's last cubes reach the first plane of the
 // next slab, which it numbers from that slab's starts.
+//
+// A block of a larger volume (docs/theory.md, "Label maps by blocks") is scanned the same way,
+// over the cubes it owns only (ScanOwnership): its image is the block's box with a one-voxel
+// apron on the high sides, its surfels are written as keys in the volume's coordinates, and
+// the border of its box never acts as the domain's border, because no owned cube reads a voxel
+// beyond the box that lies in the domain.
 #pragma once
 
 #include <algorithm>
@@ -28,6 +34,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 #include <vector>
@@ -56,11 +63,29 @@ struct LabelCounts {
 
 /// Where the fill pass writes one label's mesh, arrays of the counted sizes: vertex v is the
 /// surfel surfels[v], placed at points[v]; triangles as vertex indices, oriented so that the
-/// normal (right-hand rule) points from L to the other voxels (as TriangleMesh's).
+/// normal (right-hand rule) points from L to the other voxels (as TriangleMesh's). A block scan
+/// gives `keys` instead of surfels and points: vertex v is the surfel of key keys[v]
+/// (Surfel::key, in the volume's coordinates).
 struct LabelMeshArrays {
   Surfel* surfels = nullptr;
   std::array<double, 3>* points = nullptr;
   std::array<std::uint32_t, 3>* triangles = nullptr;
+  std::uint64_t* keys = nullptr;
+};
+
+/// The cubes a scan owns and where its image lies (docs/theory.md, "Label maps by blocks"), in
+/// the image's coordinates: the cubes whose min corner m has m_a in [lo_a, hi_a) on every axis,
+/// lo_a = -1 on an axis whose low face is the domain's (the cubes over it, which only the block
+/// at the domain's low face owns), and the voxels in [max(lo_a, 0), hi_a), which it counts.
+/// Every corner of an owned cube must lie in the image or outside the volume: hi_a < n_a, or
+/// hi_a = n_a where the image ends at the volume's high face. `origin`: the image's voxel
+/// (0, 0, 0) in the volume, added to the surfels' keys.
+struct ScanOwnership {
+  std::array<int, 3> lo{-1, -1, -1}, hi{};
+  Voxel origin{};
+
+  /// A whole image: every cube of the scanning method (paper §5.1), min corners in [-1, n).
+  static ScanOwnership whole(const Dims& dims) { return {{-1, -1, -1}, {dims.nx, dims.ny, dims.nz}, {}}; }
 };
 
 namespace scanlabels {
@@ -102,11 +127,13 @@ inline std::array<Config, 256> configTable(AdjacencyPair pair) {
 }
 
 /// One slab of planes [z0, z1): its cubes are those with min corner z in [z0, z1) (and -1 for
-/// the first slab). The count pass fills the label map and the counts; the fill pass reads the
-/// map (then holding global label indices) and the starts.
+/// the first slab when the scan owns the cubes below the domain), its surfels those of the
+/// planes [z0, planesEnd): z1, or for a block's last slab also the apron plane z1 its cubes
+/// reach, which no next slab numbers. The count pass fills the label map and the counts; the
+/// fill pass reads the map (then holding global label indices) and the starts.
 template <class T>
 struct Slab {
-  int z0 = 0, z1 = 0;
+  int z0 = 0, z1 = 0, planesEnd = 0;
   bool first = false;
   /// Each value met (on the planes the slab reads) -> its local index (count pass) or its
   /// global index (fill pass); kNone for the background and unwanted values.
@@ -230,8 +257,9 @@ template <class T, class Wanted, bool kFill, class Mapping = void*>
 class SlabScanner {
  public:
   SlabScanner(const VolumeRef<T>& image, T background, const Wanted& wanted, const std::array<Config, 256>& table,
-              Slab<T>& slab, const std::vector<LabelMeshArrays>* out = nullptr, const Mapping* mapping = nullptr)
-      : image_(image), background_(background), wanted_(wanted), table_(table), slab_(slab), out_(out),
+              const ScanOwnership& own, Slab<T>& slab, const std::vector<LabelMeshArrays>* out = nullptr,
+              const Mapping* mapping = nullptr)
+      : image_(image), background_(background), wanted_(wanted), table_(table), own_(own), slab_(slab), out_(out),
         mapping_(mapping), width_(image.dims.nx + 2),
         plane_(std::size_t(image.dims.nx + 2) * std::size_t(image.dims.ny + 2)) {
     for (auto& p : labelPlanes_) p.assign(plane_, kNone);
@@ -300,7 +328,9 @@ class SlabScanner {
       return;
     }
     const bool owned = z >= slab_.z0 && z < slab_.z1;
+    const int x0 = std::max(own_.lo[0], 0), x1 = own_.hi[0];  // the voxels counted: the owned ones
     for (int y = 0; y < dims.ny; ++y) {
+      const bool rowOwned = owned && y >= std::max(own_.lo[1], 0) && y < own_.hi[1];
       const T* row = &image_.at(0, y, z);
       const std::ptrdiff_t sx = image_.sx;
       std::uint32_t* out = plane.data() + std::size_t(y + 1) * width_ + 1;
@@ -317,7 +347,8 @@ class SlabScanner {
         const std::uint32_t L = labelIndex(value);
         std::fill(out + start, out + x, L);
         if constexpr (!kFill)
-          if (owned && L != kNone) slab_.voxels[L] += std::uint64_t(x - start);
+          if (rowOwned && L != kNone && std::min(x, x1) > std::max(start, x0))
+            slab_.voxels[L] += std::uint64_t(std::min(x, x1) - std::max(start, x0));
       }
     }
   }
@@ -329,7 +360,7 @@ class SlabScanner {
   void numberPlane(int z, int k) {
     const Dims& dims = image_.dims;
     if (z < 0 || z >= dims.nz) return;  // no voxel of any label: never read
-    const bool owned = z < slab_.z1;
+    const bool owned = z < slab_.planesEnd;
     if (!kFill && !owned) return;  // the count pass needs no surfel of the next slab
     std::uint32_t* first = first_[k].data();
     std::uint8_t* dirs = directions_[k].data();
@@ -356,7 +387,11 @@ class SlabScanner {
           std::uint32_t n = counters[L];
           first[i] = n;
           counters[L] = n + std::uint32_t(std::popcount(mask));
-          if (owned) {
+          if (owned && (*out_)[L].keys) {  // a block: the keys in the volume
+            std::uint64_t* keys = (*out_)[L].keys;
+            const Voxel c = Voxel{x, y, z} + own_.origin;
+            for (unsigned m = mask; m; m &= m - 1, ++n) keys[n] = Surfel{c, Direction(std::countr_zero(m))}.key();
+          } else if (owned) {
             const LabelMeshArrays& to = (*out_)[L];
             __builtin_prefetch(to.surfels + n + 16, 1);
             __builtin_prefetch(to.points + n + 12, 1);
@@ -371,8 +406,8 @@ class SlabScanner {
     }
   }
 
-  /// The triangles of every cube with min corner z (planes z and z + 1: first_[0], first_[1]):
-  /// counted, or written.
+  /// The triangles of every owned cube with min corner z (planes z and z + 1: first_[0],
+  /// first_[1]): counted, or written.
   void marchPlane(int z) {
     const std::uint32_t* lo = labels(z).data();
     const std::uint32_t* hi = labels(z + 1).data();
@@ -381,14 +416,14 @@ class SlabScanner {
     const std::size_t offset[8] = {0, 1, w, w + 1, 0, 1, w, w + 1};
     const std::uint32_t* first[2] = {first_[0].data(), first_[1].data()};
     const std::uint8_t* dirs[2] = {directions_[0].data(), directions_[1].data()};
-    const Dims& dims = image_.dims;
     mixed_.resize(width_ + 8);
-    for (int y = -1; y < dims.ny; ++y) {
+    const int firstColumn = own_.lo[0] + 1;  // column x + 1: the cube of min corner x
+    for (int y = own_.lo[1]; y < own_.hi[1]; ++y) {
       const std::size_t rowStart = std::size_t(y + 1) * w;
       std::uint8_t* mixed = mixed_.data();
       rowMixed(lo + rowStart, hi + rowStart, w, mixed);
-      forEachNonZero(mixed, int(w) - 1, [&](int column) {
-        const std::size_t p = rowStart + std::size_t(column);
+      forEachNonZero(mixed + firstColumn, own_.hi[0] - own_.lo[0], [&](int i) {
+        const std::size_t p = rowStart + std::size_t(firstColumn + i);
         forEachCubeLabel(lo, hi, p, w, [&](std::uint32_t L, unsigned config) {
           const Config& entry = table_[config];
           if constexpr (!kFill) {
@@ -417,6 +452,7 @@ class SlabScanner {
   T background_;
   const Wanted& wanted_;
   const std::array<Config, 256>& table_;
+  const ScanOwnership& own_;
   Slab<T>& slab_;
   const std::vector<LabelMeshArrays>* out_;
   const Mapping* mapping_;
@@ -436,27 +472,37 @@ class SlabScanner {
 
 /// Every boundary of every label L != background of `image` with wanted(L), on the arena's
 /// threads (`parts` slabs of planes): the constructor runs the count pass, fill() the fill
-/// pass. The result does not depend on `parts`.
+/// pass. The result does not depend on `parts`. With `own`, the triangles of the owned cubes
+/// only, and the voxels of the owned ones (a block, ScanOwnership); the surfels counted and
+/// numbered are still all those of the image's planes [lo_z, hi_z] it reads, so a block's
+/// caller drops those no owned triangle uses.
 template <class T, class Wanted>
 class LabelSurfaceScan {
  public:
   LabelSurfaceScan(const VolumeRef<T>& image, T background, const Wanted& wanted, AdjacencyPair pair,
-                   tbb::task_arena& arena, int parts)
+                   tbb::task_arena& arena, int parts, const std::optional<ScanOwnership>& own = std::nullopt)
       : image_(image), background_(background), wanted_(wanted), table_(scanlabels::configTable(pair)),
-        arena_(arena) {
+        own_(own ? *own : ScanOwnership::whole(image.dims)), arena_(arena) {
     using namespace scanlabels;
     const Dims& dims = image.dims;
-    parts = std::clamp(parts, 1, std::max(1, dims.nz));
+    const int z0 = std::max(own_.lo[2], 0), z1 = own_.hi[2];
+    for (int a = 0; a < 3; ++a) {
+      const int n = a == 0 ? dims.nx : a == 1 ? dims.ny : dims.nz;
+      if (own_.lo[a] < -1 || own_.lo[a] > own_.hi[a] || own_.hi[a] > n)
+        throw std::invalid_argument("LabelSurfaceScan: owned cubes beyond the image");
+    }
+    parts = std::clamp(parts, 1, std::max(1, z1 - z0));
     slabs_.resize(std::size_t(parts));
     for (int k = 0; k < parts; ++k) {
       Slab<T>& s = slabs_[std::size_t(k)];
-      s.z0 = int(std::int64_t(dims.nz) * k / parts);
-      s.z1 = int(std::int64_t(dims.nz) * (k + 1) / parts);
-      s.first = k == 0;
+      s.z0 = z0 + int(std::int64_t(z1 - z0) * k / parts);
+      s.z1 = z0 + int(std::int64_t(z1 - z0) * (k + 1) / parts);
+      s.planesEnd = k + 1 < parts ? s.z1 : std::min(s.z1 + 1, dims.nz);
+      s.first = k == 0 && own_.lo[2] == -1;
     }
     arena_.execute([&] {
       tbb::parallel_for(std::size_t(0), slabs_.size(), [&](std::size_t k) {
-        SlabScanner<T, Wanted, false>(image_, background_, wanted_, table_, slabs_[k]).run();
+        SlabScanner<T, Wanted, false>(image_, background_, wanted_, table_, own_, slabs_[k]).run();
       });
     });
     merge();
@@ -473,7 +519,8 @@ class LabelSurfaceScan {
     if (out.size() != counts_.labels.size()) throw std::invalid_argument("LabelSurfaceScan::fill: one array set per label");
     arena_.execute([&] {
       tbb::parallel_for(std::size_t(0), slabs_.size(), [&](std::size_t k) {
-        SlabScanner<T, Wanted, true, Mapping>(image_, background_, wanted_, table_, slabs_[k], &out, &mapping).run();
+        SlabScanner<T, Wanted, true, Mapping>(image_, background_, wanted_, table_, own_, slabs_[k], &out, &mapping)
+            .run();
       });
     });
   }
@@ -523,6 +570,7 @@ class LabelSurfaceScan {
   T background_;
   const Wanted& wanted_;
   std::array<scanlabels::Config, 256> table_;
+  ScanOwnership own_;
   tbb::task_arena& arena_;
   std::vector<scanlabels::Slab<T>> slabs_;
   LabelCounts<T> counts_;

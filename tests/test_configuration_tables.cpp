@@ -3,7 +3,8 @@
 // beta-arcs of Definition 38 (i)-(iii) computed from the per-edge rule (docs/theory.md,
 // 'The beta-adjacency');
 // closedness and orientation within a cube and across neighbouring cubes; supporting planes of
-// the local volume; the strict-26 tube; patches = triangulated loops; regeneration.
+// the local volume; the strict-26 tube; patches = triangulated loops; no triangle in a cube face
+// (the owning cube of block meshing); regeneration.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -128,6 +129,38 @@ TEST(ConfigurationTables, VerticesAreExactlyTheCutEdges) {
       if (isCut(config, k)) cut.insert(k);
     EXPECT_EQ(vertices, cut);
   });
+}
+
+// The owning cube of a triangle (docs/theory.md, "Label maps by blocks"): no triangle of any
+// entry lies in a face of its cube (its three cut edges never share one), so the componentwise
+// minimum of the six voxels of its three surfels is the cube's min corner. Block meshing
+// (mergeLabelFragments) orders the triangles it gathers from several blocks by that cube, so
+// this must hold for every triangle of every configuration of every pair. Checked on surfels
+// placed in a cube away from the origin (with negative coordinates too: the cubes of the
+// domain's low faces have min corner -1).
+TEST(ConfigurationTables, OwningCubeIsTheMinimumOfATrianglesVoxels) {
+  int triangles = 0;
+  for (const Voxel m : {Voxel{5, -1, 7}, Voxel{-1, -1, -1}, Voxel{0, 3, -1}})
+    forAllConfigurations([&](AdjacencyPair, int config, const CubeTriangulation& t) {
+      for (auto& tri : t.allTriangles()) {
+        for (int axis = 0; axis < 3; ++axis)
+          for (int side = 0; side < 2; ++side)
+            EXPECT_FALSE(onFace(tri[0], axis, side) && onFace(tri[1], axis, side) && onFace(tri[2], axis, side))
+                << "triangle in the cube face axis " << axis << " side " << side;
+        Voxel low{1 << 20, 1 << 20, 1 << 20};
+        for (int k : tri) {
+          ASSERT_TRUE(isCut(config, k));
+          const Surfel s = cube::surfelOnEdge(m, k, std::uint8_t(config));
+          for (const Voxel v : {s.inside(), s.outside()}) {
+            EXPECT_GE(cube::cornerOf(m, v), 0);  // both voxels are corners of the cube
+            low = {std::min(low.x, v.x), std::min(low.y, v.y), std::min(low.z, v.z)};
+          }
+        }
+        EXPECT_EQ(low, m);
+        ++triangles;
+      }
+    });
+  EXPECT_GT(triangles, 3 * 4 * 256);  // every entry but the two uniform ones has a triangle
 }
 
 TEST(ConfigurationTables, FaceEdgesAreExactlyTheBetaArcs) {

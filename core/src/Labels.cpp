@@ -22,11 +22,13 @@
 #include "FindSeed.h"
 #include "Image.h"
 #include "LabelSeeds.h"
+#include "LabelSelection.h"
 #include "LoopExtraction.h"
 #include "MeshComponents.h"
 #include "PhysicalRange.h"
 #include "PlaceSurface.h"
 #include "ScanLabels.h"
+#include "ScannedLabel.h"
 #include "SelectionValue.h"
 #include "SourceImage.h"
 #include "TrackBoundaries.h"
@@ -49,42 +51,6 @@ void forEachIndex(tbb::task_arena& arena, std::size_t n, F&& f) {
     });
   });
 }
-
-/// A list selection's labels are values of the type other than the background.
-template <class T>
-void requireListable(const LabelSelection& selection, const LabelValue& background) {
-  if (selection.labels.empty()) throw InvalidInput("empty selection: the list of labels is empty");
-  for (const LabelValue& L : selection.labels) {
-    requireSelectable(scalarTypeOf<T>(), Selection::label(L));
-    if (L == background) throw InvalidInput("label " + L.text() + " is the background");
-  }
-}
-
-void requireNonEmptyRange(const LabelSelection& selection) {
-  if (selection.first > selection.last)
-    throw InvalidInput("label range [" + selection.first.text() + ", " + selection.last.text() + "] is empty");
-}
-
-/// Whether the scan converts label L (the selection checked by requireListable /
-/// requireNonEmptyRange; selectLabels then reports the listed labels that do not occur).
-template <class T>
-struct WantedLabel {
-  const LabelSelection& selection;
-  std::vector<T> listed;  ///< List: sorted
-  explicit WantedLabel(const LabelSelection& s) : selection(s) {
-    if (s.kind == LabelSelection::Kind::List) {
-      for (const LabelValue& L : s.labels) listed.push_back(L.as<T>());
-      std::sort(listed.begin(), listed.end());
-    }
-  }
-  bool operator()(T L) const {
-    switch (selection.kind) {
-      case LabelSelection::Kind::List: return std::binary_search(listed.begin(), listed.end(), L);
-      case LabelSelection::Kind::Range: return LabelValue(L) >= selection.first && LabelValue(L) <= selection.last;
-      default: return true;
-    }
-  }
-};
 
 /// The indices in `labels` (increasing: those that occur) of the labels `selection` asks for,
 /// in increasing order.
@@ -174,24 +140,10 @@ void append(TriangleMesh& to, TriangleMesh&& from) {
   for (auto t : from.triangles) to.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
 }
 
-/// The fields of a label's result that do not depend on how its mesh was made (but the
-/// vertices, triangles and surfels).
-LabelSurface labelFields(const VoxelSource& source, LabelValue label, std::uint64_t voxels, const LabelOptions& o) {
-  LabelSurface result;
-  result.label = label;
-  result.voxels = voxels;
-  Surface& s = result.surface;
-  s.geometry = source.geometry();  // the segments smoothing keeps each vertex on (Refine.h)
-  s.pair = o.pair;
-  s.selection = Selection::label(label);
-  s.mapping = Mapping::Midpoint;
-  return result;
-}
-
 /// A label's result from its converted mesh, placed by the midpoint mapping.
 LabelSurface labelSurface(const VoxelSource& source, LabelValue label, std::uint64_t voxels, TriangleMesh&& mesh,
                           const LabelOptions& o) {
-  LabelSurface result = labelFields(source, label, voxels, o);
+  LabelSurface result = labelFields(source.geometry(), label, voxels, o);
   Surface& s = result.surface;
   placeSurface(source, std::move(mesh), Mapping::Midpoint, s.selection, 0.25, s);
   if (o.figures) addFigures(s);
@@ -218,10 +170,11 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   auto cancelled = [&] {
     if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
   };
+  const ImageGeometry geometry = source.geometry();
   std::vector<LabelSurface> out(n);
   std::vector<LabelMeshArrays> arrays(n);
   forEachIndex(arena, n, [&](std::size_t i) {
-    out[i] = labelFields(source, LabelValue(counts.labels[i]), counts.voxels[i], o);
+    out[i] = labelFields(geometry, LabelValue(counts.labels[i]), counts.voxels[i], o);
     Surface& s = out[i].surface;
     s.vertices.resize(counts.surfels[i]);
     s.surfels.resize(counts.surfels[i]);
@@ -229,7 +182,6 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
     arrays[i] = {s.surfels.data(), s.vertices.data(), s.triangles.data()};
   });
   cancelled();
-  const ImageGeometry geometry = source.geometry();
   scan.fill(arrays, [&](const Surfel& s) { return geometry.toPhysical(MidpointMapping{}(s)); });
   for (const LabelSurface& l : out) {  // (as placeSurface checks its vertices: PhysicalRange.h)
     const Surface& s = l.surface;
@@ -244,13 +196,7 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
                    [&](std::size_t a, std::size_t b) { return counts.surfels[a] > counts.surfels[b]; });
   forEachIndex(arena, n, [&](std::size_t k) {
     cancelled();
-    Surface& s = out[order[k]].surface;
-    if (mirrored)
-      for (auto& t : s.triangles) std::swap(t[1], t[2]);
-    if (o.figures) addFigures(s);
-    std::size_t boundaries = s.components.size();
-    if (!o.figures) triangleComponents(s.vertices.size(), s.triangles, boundaries);
-    s.boundariesInImage = boundaries;
+    finishScannedLabel(out[order[k]].surface, mirrored, o);
   });
   return out;
 }

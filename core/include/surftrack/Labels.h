@@ -12,6 +12,7 @@
 // A-voxel and a B-voxel is a vertex of both meshes at the same point.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -87,6 +88,43 @@ struct LabelSurface {
 /// \throw Cancelled when options.cancel is raised.
 /// \throw InternalError when an engine invariant fails (a bug).
 std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options);
+
+/// One label's part of the mesh of one block of a volume (docs/api.md, "Label maps by
+/// blocks"; docs/theory.md, "Label maps by blocks"): the triangles of the cubes the block owns.
+struct LabelFragment {
+  LabelValue label;          ///< exact over the whole range of every integer type
+  std::uint64_t voxels = 0;  ///< voxels of the label in the block's core
+  /// The vertices: their surfels' keys (Surfel::key, volume coordinates), increasing, each
+  /// used by a triangle.
+  std::vector<std::uint64_t> keys;
+  /// Indices into keys, in the table's orientation (geometry not applied), in the order of the
+  /// single pass: by owned cube (z, y, x), then the configuration table's order.
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+/// The fragments of every selected label of one block of a volume of `volume` voxels, by
+/// increasing label: those with triangles in the block's cubes or voxels in its core. The block's
+/// core is the box [lo, hi) of the volume; it owns the cubes whose min corner lies in [lo, hi)
+/// on every axis, and also at -1 on an axis where lo = 0. `view` holds the voxels
+/// [origin, origin + view.dims) of the volume, which must contain [lo, min(hi + 1, volume))
+/// (a one-voxel apron on the high sides) and lie in the volume; view.geometry is not used.
+/// The options' pair, labels, background and threads apply; a listed label need not occur in
+/// the block. For each label, mergeLabelFragments over the fragments of all blocks of any
+/// partition of the volume gives extractLabels' surface of that label.
+/// \throw InvalidInput for a float view, a view or core that does not fit as above, volume
+///        dimensions beyond the surfel keys' range, seeds, LabelBoundaries::Largest, a
+///        selection as extractLabels refuses it (but a listed label that does not occur).
+std::vector<LabelFragment> scanLabelBlock(const VolumeView& view, Voxel origin, Dims volume, Voxel lo, Voxel hi,
+                                          const LabelOptions& options);
+
+/// The surface of one label from its fragments of every block of a partition of the volume
+/// (any order): the same LabelSurface extractLabels gives for that label over the whole
+/// volume with `geometry` and options' pair and figures, field for field, vertices bit-equal.
+/// \throw InvalidInput for no fragment, fragments of several labels, keys not increasing or
+///        out of the key range, a triangle index beyond its fragment's keys, more than 2^32 - 1
+///        vertices, vertices beyond the float range.
+LabelSurface mergeLabelFragments(const std::vector<LabelFragment>& fragments, const ImageGeometry& geometry,
+                                 const LabelOptions& options);
 
 /// Writes every surface into one PLY file (binary little-endian, or text): the vertices of each
 /// label in turn (float x, y, z; a vertex on an interface once per label it bounds), the faces

@@ -1,0 +1,222 @@
+// scanLabelBlock and mergeLabelFragments (docs/api.md, "Label maps by blocks"): every label's
+// surface meshed block by block and merged, equal to the single pass of extractLabels. The proof
+// is docs/theory.md, "Label maps by blocks": the blocks' owned cubes partition the cubes of the
+// scanning method (paper §5.1); a cube's triangles depend on its 8 voxels only, which a block
+// reads (its box has a one-voxel apron on the high sides); a vertex is a surfel, named by its key
+// in the volume, so the fragments' vertices need no welding; and the single pass's order is that
+// of the keys for the vertices and of the owning cubes for the triangles, which the merge
+// restores.
+#include <algorithm>
+#include <limits>
+#include <sstream>
+#include <type_traits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "BoundaryMapping.h"
+#include "Image.h"
+#include "LabelSelection.h"
+#include "Labels.h"
+#include "PhysicalRange.h"
+#include "ScanLabels.h"
+#include "ScannedLabel.h"
+
+namespace surftrack {
+namespace {
+
+std::string boxText(Voxel lo, Voxel hi) {
+  std::ostringstream s;
+  s << "[" << lo.x << "," << hi.x << ")x[" << lo.y << "," << hi.y << ")x[" << lo.z << "," << hi.z << ")";
+  return s.str();
+}
+
+/// The block's core, box and volume fit together (scanLabelBlock's contract), or InvalidInput.
+void requireBlock(const VolumeView& view, Voxel origin, Dims volume, Voxel lo, Voxel hi) {
+  for (int a = 0; a < 3; ++a)
+    if (volume[a] <= 0 || volume[a] >= Surfel::kCoordinateLimit - 2) {
+      std::ostringstream msg;
+      msg << "volume dimensions " << volume.nx << "x" << volume.ny << "x" << volume.nz
+          << " are not supported: each must be in [1, " << Surfel::kCoordinateLimit - 3 << "]";
+      throw InvalidInput(msg.str());
+    }
+  const Voxel end = origin + Voxel{view.dims.nx, view.dims.ny, view.dims.nz};
+  const Voxel size{volume.nx, volume.ny, volume.nz};
+  for (int a = 0; a < 3; ++a) {
+    if (lo[a] < 0 || lo[a] >= hi[a] || hi[a] > volume[a])
+      throw InvalidInput("block core " + boxText(lo, hi) + " is empty or not in the volume " +
+                         boxText({}, size));
+    if (origin[a] < 0 || end[a] > volume[a])
+      throw InvalidInput("block box " + boxText(origin, end) + " is not in the volume " + boxText({}, size));
+    if (origin[a] > lo[a] || end[a] < std::min(hi[a] + 1, volume[a]))
+      throw InvalidInput("block box " + boxText(origin, end) + " does not hold the core " + boxText(lo, hi) +
+                         " and its one-voxel apron on the high sides");
+  }
+}
+
+template <class T>
+std::vector<LabelFragment> scanBlockTyped(const VolumeView& view, Voxel origin, Voxel lo, Voxel hi,
+                                          const LabelOptions& o) {
+  if (!o.background.fits<T>())
+    throw InvalidInput("background " + o.background.text() + " is not a value of " + toString(scalarTypeOf<T>()) +
+                       " voxels");
+  if (o.labels.kind == LabelSelection::Kind::List) requireListable<T>(o.labels, o.background);
+  if (o.labels.kind == LabelSelection::Kind::Range) requireNonEmptyRange(o.labels);
+  const VolumeRef<T> image(static_cast<const T*>(view.data), view.dims, view.strides[0], view.strides[1],
+                           view.strides[2]);
+  // The owned cubes in the box's coordinates; -1 where the core starts at the volume's low face
+  // (then the box does too), the cubes over that face.
+  ScanOwnership own;
+  own.origin = origin;
+  for (int a = 0; a < 3; ++a) {
+    own.lo[std::size_t(a)] = lo[a] == 0 ? -1 : lo[a] - origin[a];
+    own.hi[std::size_t(a)] = hi[a] - origin[a];
+  }
+  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
+  const int parts = o.threads == 1 ? 1 : std::min(hi.z - lo.z, 4 * std::max(1, arena.max_concurrency()));
+  const WantedLabel<T> wanted(o.labels);
+  LabelSurfaceScan<T, WantedLabel<T>> scan(image, o.background.as<T>(), wanted, o.pair, arena, parts, own);
+  const LabelCounts<T>& counts = scan.counts();
+
+  const std::size_t n = counts.labels.size();
+  std::vector<LabelFragment> all(n);
+  std::vector<LabelMeshArrays> arrays(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    LabelFragment& f = all[i];
+    f.label = LabelValue(counts.labels[i]);
+    f.voxels = counts.voxels[i];
+    f.keys.resize(counts.surfels[i]);
+    f.triangles.resize(counts.triangles[i]);
+    arrays[i].keys = f.keys.data();
+    arrays[i].triangles = f.triangles.data();
+  }
+  if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+  scan.fill(arrays, [](const Surfel&) { return std::array<double, 3>{}; });  // keys only: never placed
+
+  // The scan numbered every surfel of the planes it read; an owned cube's triangles use only
+  // surfels of the volume (both voxels in the box or outside the volume), the others are dropped.
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+      LabelFragment& f = all[i];
+      std::vector<std::uint32_t> index(f.keys.size(), 0);
+      for (const auto& t : f.triangles)
+        for (std::uint32_t v : t) index[v] = 1;
+      std::uint32_t next = 0;
+      for (std::size_t v = 0; v < index.size(); ++v)
+        if (index[v]) {
+          f.keys[next] = f.keys[v];  // next <= v: in place, still increasing
+          index[v] = next++;
+        }
+      f.keys.resize(next);
+      f.keys.shrink_to_fit();
+      for (auto& t : f.triangles)
+        for (std::uint32_t& v : t) v = index[v];
+    });
+  });
+  // Labels met only in the apron with no triangle in the owned cubes belong to other blocks.
+  std::erase_if(all, [](const LabelFragment& f) { return f.voxels == 0 && f.triangles.empty(); });
+  return all;
+}
+
+/// The min corner of the cube that owns a triangle of these surfels: the componentwise minimum
+/// of their six voxels (no table triangle lies in a cube face, tests/test_configuration_tables.cpp),
+/// packed so that the order of the packed values is the scan's order of the cubes (z, y, x).
+std::uint64_t owningCube(const std::array<std::uint64_t, 3>& keys) {
+  Voxel m{std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max()};
+  for (std::uint64_t key : keys) {
+    const Surfel s = Surfel::fromKey(key);
+    for (const Voxel v : {s.inside(), s.outside()}) m = {std::min(m.x, v.x), std::min(m.y, v.y), std::min(m.z, v.z)};
+  }
+  auto field = [](int v) { return std::uint64_t(v + Surfel::kCoordinateLimit) & 0x1FFFFFu; };
+  return field(m.z) << 42 | field(m.y) << 21 | field(m.x);
+}
+
+}  // namespace
+
+std::vector<LabelFragment> scanLabelBlock(const VolumeView& view, Voxel origin, Dims volume, Voxel lo, Voxel hi,
+                                          const LabelOptions& options) {
+  if (!isInteger(view.type))
+    throw InvalidInput("a label image needs integer voxels: this one has " + toString(view.type) + " voxels");
+  if (options.threads < 0)
+    throw InvalidInput("threads " + std::to_string(options.threads) + " is negative (0: all cores)");
+  if (!options.seeds.empty())
+    throw InvalidInput("a block scan meshes every boundary: seeds select boundaries of the whole volume");
+  if (options.boundaries != LabelBoundaries::All)
+    throw InvalidInput("a block scan meshes every boundary: the largest is a property of the whole volume");
+  makeViewSource(view);  // checks the view
+  requireBlock(view, origin, volume, lo, hi);
+  return visitScalarType(view.type, [&](auto zero) -> std::vector<LabelFragment> {
+    using T = decltype(zero);
+    if constexpr (std::is_integral_v<T>)
+      return scanBlockTyped<T>(view, origin, lo, hi, options);
+    else
+      throw InternalError("scanLabelBlock: a float type passed the integer check");
+  });
+}
+
+LabelSurface mergeLabelFragments(const std::vector<LabelFragment>& fragments, const ImageGeometry& geometry,
+                                 const LabelOptions& options) {
+  if (fragments.empty()) throw InvalidInput("no fragment to merge");
+  const LabelValue label = fragments.front().label;
+  std::uint64_t voxels = 0;
+  std::size_t keyCount = 0, triangleCount = 0;
+  for (const LabelFragment& f : fragments) {
+    if (f.label != label)
+      throw InvalidInput("fragments of labels " + label.text() + " and " + f.label.text() + " in one merge");
+    for (std::size_t v = 0; v < f.keys.size(); ++v)
+      if (f.keys[v] >> 63 || (f.keys[v] & 7) > 5 || (v > 0 && f.keys[v] <= f.keys[v - 1]))
+        throw InvalidInput("a fragment of label " + label.text() + " has keys out of range or not increasing");
+    for (const auto& t : f.triangles)
+      for (std::uint32_t v : t)
+        if (v >= f.keys.size())
+          throw InvalidInput("a fragment of label " + label.text() + " has a triangle beyond its vertices");
+    voxels += f.voxels;
+    keyCount += f.keys.size();
+    triangleCount += f.triangles.size();
+  }
+
+  // The vertices: the union of the fragments' surfels, by increasing key, the order in which the
+  // single pass numbers them (plane, row, voxel, direction).
+  std::vector<std::uint64_t> keys;
+  keys.reserve(keyCount);
+  for (const LabelFragment& f : fragments) keys.insert(keys.end(), f.keys.begin(), f.keys.end());
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  if (keys.size() > std::numeric_limits<std::uint32_t>::max())
+    throw InvalidInput("label " + label.text() + " has more than 2^32 - 1 surfels");
+
+  // The triangles renumbered, then in the single pass's order: by owning cube (the blocks own
+  // disjoint cubes, each fragment in the scan's order), stably, so the table's order within a cube.
+  std::vector<std::pair<std::uint64_t, std::array<std::uint32_t, 3>>> triangles;
+  triangles.reserve(triangleCount);
+  for (const LabelFragment& f : fragments) {
+    std::vector<std::uint32_t> global(f.keys.size());
+    auto at = keys.begin();
+    for (std::size_t v = 0; v < f.keys.size(); ++v) {  // both increasing: one walk
+      at = std::lower_bound(at, keys.end(), f.keys[v]);
+      global[v] = std::uint32_t(at - keys.begin());
+    }
+    for (const auto& t : f.triangles)
+      triangles.push_back({owningCube({f.keys[t[0]], f.keys[t[1]], f.keys[t[2]]}),
+                           {global[t[0]], global[t[1]], global[t[2]]}});
+  }
+  std::stable_sort(triangles.begin(), triangles.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+
+  LabelSurface out = labelFields(geometry, label, voxels, options);
+  Surface& s = out.surface;
+  s.triangles.resize(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) s.triangles[t] = triangles[t].second;
+  std::vector<std::pair<std::uint64_t, std::array<std::uint32_t, 3>>>().swap(triangles);
+  s.surfels.resize(keys.size());
+  s.vertices.resize(keys.size());
+  for (std::size_t v = 0; v < keys.size(); ++v) {
+    s.surfels[v] = Surfel::fromKey(keys[v]);
+    s.vertices[v] = geometry.toPhysical(MidpointMapping{}(s.surfels[v]));  // the single pass's expression
+  }
+  requirePlacedVertices(geometry, s.vertices, [&](std::size_t v) { return MidpointMapping{}(s.surfels[v]); });
+  finishScannedLabel(s, geometry.handedness() < 0, options);
+  return out;
+}
+
+}  // namespace surftrack
