@@ -20,6 +20,8 @@ packages=(
   python3-pytest python3-skimage python3-nibabel python3-meshio  # its tests and examples
   python3-venv python3-pip python3-setuptools  # 'pip install --no-build-isolation .' in a venv
   python3-tifffile               # TIFF stacks (ImageJ, OME-TIFF) written independently for tests/test_tiff_stacks.py
+  python3-dask python3-distributed  # surftrack.distributed: every label by blocks on a Dask cluster
+  python3-zarr                   # zarr stores for surftrack.distributed and its tests
   mricron-data                   # real MRI volumes used by the demo and one test
 )
 

@@ -418,6 +418,85 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
   return out;
 }
 
+/// Array axes (z, y, x) as the engine's voxel (x, y, z): engine x is the last array axis, as
+/// the block functions below read the array (order {2, 1, 0}).
+Voxel engineVoxel(const std::array<int, 3>& zyx) { return Voxel{zyx[2], zyx[1], zyx[0]}; }
+constexpr std::array<int, 3> kLastAxisFirst = {2, 1, 0};
+
+/// scanLabelBlock (docs/theory.md, "Label maps by blocks") on `box`, the voxels [origin,
+/// origin + box.shape) of a volume of shape `volume`, owning the cubes of [lo, hi) (all in array
+/// axes): per label, (label, voxels, keys (uint64), triangles ((M, 3) uint32)).
+py::list scanLabelBlockArray(py::array box, std::array<int, 3> origin, std::array<int, 3> volume,
+                             std::array<int, 3> lo, std::array<int, 3> hi, py::object background,
+                             const std::string& adjacency) {
+  const VolumeView view = viewOfArray(box, kLastAxisFirst, {1, 1, 1}, {0, 0, 0}, {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}});
+  LabelOptions o;
+  o.background = labelOf(background, "background");
+  o.pair = parseAdjacencyPair(adjacency);
+  o.figures = false;
+  const Voxel v = engineVoxel(volume);
+  std::vector<LabelFragment> fragments;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] {
+    fragments = scanLabelBlock(view, engineVoxel(origin), Dims{v.x, v.y, v.z}, engineVoxel(lo), engineVoxel(hi), o);
+  });
+  py::list out;
+  for (LabelFragment& f : fragments) {
+    py::array_t<std::uint64_t> keys(py::ssize_t(f.keys.size()));
+    std::copy(f.keys.begin(), f.keys.end(), keys.mutable_data());
+    py::array_t<std::uint32_t> triangles({py::ssize_t(f.triangles.size()), py::ssize_t(3)});
+    if (!f.triangles.empty()) std::memcpy(triangles.mutable_data(), f.triangles.data(), f.triangles.size() * 12);
+    out.append(py::make_tuple(labelObject(f.label), f.voxels, keys, triangles));
+  }
+  return out;
+}
+
+/// mergeLabelFragments: the fragments (voxels, keys, triangles) of `label` from every block of a
+/// partition, as label_surfaces_array gives that label (geometry in array axes).
+py::dict mergeLabelFragmentsArrays(py::object label, py::list fragments, std::array<double, 3> spacing,
+                                   std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
+                                   py::object background, const std::string& adjacency, bool figures) {
+  ImageGeometry geometry;
+  for (int e = 0; e < 3; ++e) {
+    const int a = kLastAxisFirst[e];
+    geometry.spacing[e] = spacing[a];
+    for (int k = 0; k < 3; ++k) geometry.direction[k][e] = direction[k][a];
+  }
+  geometry.origin = origin;
+  LabelOptions o;
+  o.background = labelOf(background, "background");
+  o.pair = parseAdjacencyPair(adjacency);
+  o.figures = figures;
+  const LabelValue L = labelOf(label, "label");
+  std::vector<LabelFragment> parts;
+  for (py::handle h : fragments) {
+    const py::tuple t = h.cast<py::tuple>();
+    const auto keys = t[1].cast<py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>>();
+    const auto triangles = t[2].cast<py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>>();
+    if (keys.ndim() != 1 || triangles.ndim() != 2 || triangles.shape(1) != 3)
+      throw py::value_error("a fragment is (voxels, keys (K,), triangles (M, 3))");
+    LabelFragment f;
+    f.label = L;
+    f.voxels = t[0].cast<std::uint64_t>();
+    f.keys.assign(keys.data(), keys.data() + keys.shape(0));
+    f.triangles.resize(std::size_t(triangles.shape(0)));
+    if (!f.triangles.empty()) std::memcpy(f.triangles.data(), triangles.data(), f.triangles.size() * 12);
+    parts.push_back(std::move(f));
+  }
+  auto r = std::make_shared<Result>();
+  r->order = kLastAxisFirst;
+  std::uint64_t voxels = 0;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] {
+    LabelSurface merged = mergeLabelFragments(parts, geometry, o);
+    voxels = merged.voxels;
+    r->surface = std::move(merged.surface);
+  });
+  py::dict d = surfaceDict(r);
+  d["voxels"] = voxels;
+  return d;
+}
+
 void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
                  py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> faces,
                  py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> surfels,
@@ -510,4 +589,6 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
   m.def("write_precomputed", &writePrecomputed);
+  m.def("scan_label_block", &scanLabelBlockArray);
+  m.def("merge_label_fragments", &mergeLabelFragmentsArrays);
 }

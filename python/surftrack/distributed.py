@@ -1,0 +1,251 @@
+"""Every label of a volume larger than one machine, by blocks on Dask (docs/python.md, "Every
+label by blocks, on Dask"; the proof of exactness is docs/theory.md, "Label maps by blocks").
+
+A block owns the cubes whose minimum corner lies in its core and reads one more voxel on its
+high sides; each of its labels' fragments holds global surfel keys and the triangles of the cubes
+it owns. A label's fragments from every block, merged (keys made unique, triangles in the single
+pass' order, vertices placed by the single pass' expression), are exactly that label's surface
+from ``label_surfaces`` on the whole array: same arrays, same bytes written. No welding, no
+tolerance, no repair.
+
+The graph: one task per block (reads its box from the array — a zarr array, or anything indexed
+as numpy is — and writes one fragment file; a block whose file exists is not computed again, so
+a stopped run resumes), one plan task, one task per shard of labels (reads its labels' fragments
+from the files, merges, writes or returns). Fragments go through the file system, never through
+the scheduler: ``work_dir`` must be shared by every worker.
+"""
+from __future__ import annotations
+
+import itertools
+import os
+import tempfile
+import uuid
+from pathlib import Path
+
+import numpy as np
+
+from . import _surftrack
+
+_IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def block_grid(shape, block):
+    """The blocks of an array of `shape` cut every `block` voxels: a list of (lo, hi) triples
+    (the last block of an axis is shorter where `block` does not divide it)."""
+    shape = tuple(int(n) for n in shape)
+    block = tuple(int(b) for b in block)
+    if len(shape) != 3 or len(block) != 3 or min(block) < 1:
+        raise ValueError(f"block must be three positive sizes for a 3-D array, not {block!r}")
+    axes = [[(lo, min(lo + b, n)) for lo in range(0, n, b)] for n, b in zip(shape, block)]
+    return [(tuple(a[0] for a in c), tuple(a[1] for a in c)) for c in itertools.product(*axes)]
+
+
+def _fragment_path(work_dir, lo):
+    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}.npz"
+
+
+def _summary(path):
+    """{label: (vertices, triangles)} of a fragment file."""
+    with np.load(path) as f:
+        labels = [int(s) for s in f["labels"]]
+        keys, tris = np.diff(f["key_offsets"]), np.diff(f["triangle_offsets"])
+    return {L: (int(k), int(t)) for L, k, t in zip(labels, keys, tris)}
+
+
+def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir):
+    """Task: the fragments of one block, written to its file (atomically: a retried or repeated
+    task writes the same bytes; an existing file is kept, so a resumed run skips the block)."""
+    path = _fragment_path(work_dir, lo)
+    if path.exists():
+        return str(path), _summary(path)
+    top = [min(h + 1, n) for h, n in zip(hi, shape)]  # the one-voxel apron on the high sides
+    box = np.ascontiguousarray(source[lo[0]:top[0], lo[1]:top[1], lo[2]:top[2]])
+    if box.dtype.kind not in "biu":
+        raise ValueError(f"a label image needs integer voxels, not {box.dtype}")
+    fragments = _surftrack.scan_label_block(box, list(lo), list(shape), list(lo), list(hi), background, adjacency)
+    labels = np.array([str(f[0]) for f in fragments])  # decimal text: uint64 and int64 ids exact
+    key_offsets = np.cumsum([0] + [len(f[2]) for f in fragments], dtype=np.int64)
+    triangle_offsets = np.cumsum([0] + [len(f[3]) for f in fragments], dtype=np.int64)
+    temporary = path.with_name(f".{path.name}.{uuid.uuid4().hex}.npz")
+    np.savez(temporary, labels=labels, voxels=np.array([f[1] for f in fragments], dtype=np.uint64),
+             key_offsets=key_offsets, triangle_offsets=triangle_offsets,
+             keys=np.concatenate([f[2] for f in fragments]) if fragments else np.zeros(0, np.uint64),
+             triangles=np.concatenate([f[3] for f in fragments]) if fragments else np.zeros((0, 3), np.uint32))
+    os.replace(temporary, path)
+    return str(path), {f[0]: (len(f[2]), len(f[3])) for f in fragments}
+
+
+def _plan(results, shards):
+    """Task: label -> its blocks' files, the labels dealt to `shards` shards by vertex count
+    (largest first, each to the lightest shard)."""
+    where, weight = {}, {}
+    for path, summary in results:
+        for label, (keys, _) in summary.items():
+            where.setdefault(label, []).append(path)
+            weight[label] = weight.get(label, 0) + keys
+    load = [0] * shards
+    plan = [[] for _ in range(shards)]
+    for label in sorted(where, key=lambda L: (-weight[L], L)):
+        s = load.index(min(load))
+        plan[s].append((label, where[label]))
+        load[s] += weight[label]
+    return [p for p in plan if p]
+
+
+def _merge_label(label, paths, geometry, background, adjacency, figures):
+    fragments = []
+    for path in paths:
+        with np.load(path) as f:
+            i = [int(s) for s in f["labels"]].index(label)
+            k0, k1 = f["key_offsets"][i:i + 2]
+            t0, t1 = f["triangle_offsets"][i:i + 2]
+            fragments.append((int(f["voxels"][i]), f["keys"][k0:k1], f["triangles"][t0:t1]))
+    spacing, origin, direction = geometry
+    return _surftrack.merge_label_fragments(label, fragments, spacing, origin, direction, background,
+                                            adjacency, figures)
+
+
+def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir):
+    """Task: every label of a shard merged; written as DIR/label_<L>.ply when `out_dir` is given
+    (the files only, returned as figures), else the surfaces' fields returned."""
+    from . import Surface
+    out = {}
+    for label, paths in shard:
+        fields = _merge_label(label, paths, geometry, background, adjacency, figures)
+        if out_dir is None:  # plain arrays through the scheduler (the C++ result does not pickle)
+            result = fields.pop("result")
+            fields["surfels"], fields["normals"] = result.surfels(), result.normals()
+            out[label] = fields
+            continue
+        surface = Surface(**fields)
+        surface.write(str(Path(out_dir) / f"label_{label}.ply"))
+        out[label] = {"voxels": fields["voxels"], "vertices": len(surface.vertices),
+                      "triangles": len(surface.faces), "euler": fields["euler"]}
+    return out
+
+
+def _run(source, *, block, spacing, origin, direction, background, adjacency, figures, client, workers,
+         work_dir, out_dir, shards, progress):
+    from dask.distributed import Client, LocalCluster, as_completed
+    from . import _geometry
+
+    shape = tuple(int(n) for n in source.shape)
+    if len(shape) != 3:
+        raise ValueError(f"the label image must be 3-D, not of shape {shape}")
+    if np.dtype(source.dtype).kind not in "biu":
+        raise ValueError(f"a label image needs integer voxels: this one has {source.dtype} voxels")
+    if adjacency not in ("26-6", "18-6", "6-18", "6-26"):
+        raise ValueError(f"unsupported adjacency pair '{adjacency}'")
+    blocks = block_grid(shape, block)
+    spacing, origin, direction = _geometry(spacing, origin, direction)
+    geometry = (list(spacing), list(origin), direction.tolist())
+    own_cluster = None
+    if client is None:
+        own_cluster = LocalCluster(n_workers=workers or min(os.cpu_count() or 1, 4), threads_per_worker=1,
+                                   processes=True, dashboard_address=None)
+        client = Client(own_cluster)
+    try:
+        _require_memory(client, block, np.dtype(source.dtype).itemsize)
+        if isinstance(source, np.ndarray):  # sent to the workers once, not with every task
+            source = client.scatter(source, broadcast=False)
+        futures = [client.submit(_mesh_block, source, lo, hi, shape, background, adjacency, work_dir,
+                                 key=f"surftrack-block-{lo[0]}-{lo[1]}-{lo[2]}-{uuid.uuid4().hex[:8]}",
+                                 pure=False) for lo, hi in blocks]
+        done = 0
+        for _ in as_completed(futures):
+            done += 1
+            if progress:
+                progress("blocks", done, len(blocks))
+        plan = client.submit(_plan, futures, shards or max(1, 2 * len(client.scheduler_info()["workers"])), pure=False)
+        shard_list = plan.result()
+        reduced = [client.submit(_reduce_shard, s, geometry, background, adjacency, figures, out_dir, pure=False)
+                   for s in shard_list]
+        out, merged, total = {}, 0, sum(len(s) for s in shard_list)
+        for future in as_completed(reduced):
+            part = future.result()
+            out.update(part)
+            merged += len(part)
+            if progress:
+                progress("labels", merged, total)
+        return out
+    finally:
+        if own_cluster is not None:
+            client.close()
+            own_cluster.close()
+
+
+def _require_memory(client, block, itemsize):
+    """A block task holds its box with the apron, a copy of it, and about 8 bytes a voxel of
+    fragments: refused before the run when that exceeds a worker's memory limit."""
+    voxels = np.prod([b + 1 for b in block], dtype=np.float64)
+    need = voxels * (2 * itemsize + 8)
+    limits = [w.get("memory_limit") or 0 for w in client.scheduler_info()["workers"].values()]
+    limit = min((m for m in limits if m), default=0)
+    if limit and need > 0.6 * limit:
+        side = int(((0.6 * limit) / (2 * itemsize + 8)) ** (1 / 3)) - 1
+        raise ValueError(f"a block of {block} needs about {need / 2**20:.0f} MiB, more than 60% of a "
+                         f"worker's {limit / 2**20:.0f} MiB: use block=({side}, {side}, {side}) or smaller")
+
+
+def label_surfaces(labels, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
+                   direction=None, background=0, adjacency="26-6", figures=True, client=None, workers=None,
+                   work_dir=None, shards=None, progress=None) -> dict:
+    """``surftrack.label_surfaces(labels, ...)`` computed by blocks on Dask: the same dict of
+    label -> Surface, array for array. ``labels`` is a 3-D integer array read by slicing (a zarr
+    array, a numpy array, a memory map). ``client``: a ``dask.distributed.Client`` (any cluster);
+    None starts a LocalCluster of ``workers`` processes for the call. ``work_dir`` holds the
+    fragment files (shared by the workers; a temporary directory by default; given again, the
+    blocks already there are not recomputed). ``progress(stage, done, total)`` with stage
+    "blocks" then "labels". The surfaces come back through the scheduler: for labels too large
+    for that, ``write_label_meshes``."""
+    from . import Surface
+    with _work_dir(work_dir) as work:
+        fields = _run(labels, block=block, spacing=spacing, origin=origin, direction=direction,
+                      background=background, adjacency=adjacency, figures=figures, client=client,
+                      workers=workers, work_dir=work, out_dir=None, shards=shards, progress=progress)
+    return {label: Surface(**fields[label]) for label in sorted(fields)}
+
+
+def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0),
+                       origin=(0.0, 0.0, 0.0), direction=None, background=0, adjacency="26-6", client=None,
+                       workers=None, work_dir=None, shards=None, progress=None) -> dict:
+    """Every label's surface written as ``out_dir/label_<L>.ply`` by the reduce tasks, each file
+    byte-identical to ``surftrack.label_surfaces(labels, ...)[L].write(...)`` on the whole array.
+    ``out_dir`` (shared by the workers) must not exist or be empty; it appears whole at the end
+    or not at all. Returns label -> figures (voxels, vertices, triangles, euler)."""
+    target = Path(out_dir)
+    if target.exists() and (not target.is_dir() or any(target.iterdir())):
+        raise ValueError(f"cannot write into '{out_dir}': it exists and is not an empty directory")
+    staging = target.parent / f".{target.name}.tmp-{uuid.uuid4().hex}"
+    staging.mkdir(parents=True)
+    try:
+        with _work_dir(work_dir) as work:
+            figures = _run(labels, block=block, spacing=spacing, origin=origin, direction=direction,
+                           background=background, adjacency=adjacency, figures=True, client=client,
+                           workers=workers, work_dir=work, out_dir=str(staging), shards=shards,
+                           progress=progress)
+        os.replace(staging, target)  # replaces an empty directory
+    except BaseException:
+        for f in staging.glob("*"):
+            f.unlink()
+        staging.rmdir()
+        raise
+    return dict(sorted(figures.items()))
+
+
+class _work_dir:
+    """`path` (created if need be, kept), or a temporary directory removed at the end."""
+
+    def __init__(self, path):
+        self.path, self.temporary = path, None
+
+    def __enter__(self):
+        if self.path is None:
+            self.temporary = tempfile.TemporaryDirectory(prefix="surftrack-blocks-")
+            return self.temporary.name
+        Path(self.path).mkdir(parents=True, exist_ok=True)
+        return str(self.path)
+
+    def __exit__(self, *exc):
+        if self.temporary is not None:
+            self.temporary.cleanup()

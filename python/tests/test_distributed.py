@@ -1,0 +1,143 @@
+"""surftrack.distributed: every label by blocks on a Dask LocalCluster of two worker processes,
+against surftrack.label_surfaces on the whole array (the single pass): the same arrays for every
+label and pair on random label images cut into blocks the shape does not divide (1-voxel-thick
+blocks and a single block included), byte-identical PLY files from a zarr store, uint64 ids
+around 2^53 and 2^64 - 1 exact, a resumed run that recomputes no finished block, a worker killed
+mid-run that changes nothing, and bad input refused before the run."""
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import surftrack
+
+distributed = pytest.importorskip("dask.distributed")
+zarr = pytest.importorskip("zarr")
+
+from surftrack import distributed as blocks  # noqa: E402
+
+IDS = [2**64 - 1, 2**53 + 1, 2**53, 2**53 - 1, 3]
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       memory_limit="1GiB", dashboard_address=None)
+    with distributed.Client(cluster) as c:
+        yield c
+    cluster.close()
+
+
+def random_labels(rng, shape):
+    labels = np.zeros(shape, np.uint64)
+    for _ in range(int(rng.integers(3, 12))):
+        lo = rng.integers(-2, shape, size=3).clip(0)
+        hi = lo + rng.integers(1, 7, size=3)
+        labels[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]] = IDS[int(rng.integers(len(IDS)))]
+    labels[tuple(rng.integers(0, shape, size=3))] = IDS[0]  # a single voxel somewhere
+    labels[0, 0, 0] = IDS[1]  # and one in a corner
+    return labels
+
+
+def expect_same(got, want):
+    assert sorted(got) == sorted(want)
+    for label, w in want.items():
+        g = got[label]
+        assert np.array_equal(g.vertices, w.vertices) and np.array_equal(g.faces, w.faces), label
+        assert np.array_equal(g.surfels, w.surfels)
+        assert g.voxels == w.voxels and g.euler == w.euler and g.components == w.components
+
+
+@pytest.mark.parametrize("adjacency", ["26-6", "18-6", "6-18", "6-26"])
+def test_blocks_merge_to_the_single_pass(client, adjacency):
+    rng = np.random.default_rng({"26-6": 1, "18-6": 2, "6-18": 3, "6-26": 4}[adjacency])
+    for block in [(4, 3, 5), (1, 6, 2), (20, 20, 20), (5, 1, 7)]:
+        labels = random_labels(rng, tuple(rng.integers(7, 12, size=3)))
+        spacing = tuple(float(v) for v in rng.choice([0.5, 1.0, 4.0], size=3))
+        want = surftrack.label_surfaces(labels, spacing=spacing, origin=(1, -2, 3), adjacency=adjacency)
+        got = blocks.label_surfaces(labels, block=block, spacing=spacing, origin=(1, -2, 3),
+                                    adjacency=adjacency, client=client)
+        expect_same(got, want)
+
+
+def test_zarr_store_gives_byte_identical_files_and_resumes(client, tmp_path):
+    rng = np.random.default_rng(9)
+    shape = (61, 47, 53)
+    # Voronoi cells of 40 seeds: walls everywhere, labels touching the array's faces.
+    seeds = rng.integers(0, shape, size=(40, 3))
+    grid = np.stack(np.indices(shape), axis=-1).reshape(-1, 1, 3)
+    cells = np.argmin(((grid - seeds[None]) ** 2).sum(-1), axis=1).reshape(shape)
+    labels = (np.uint64(2**64 - 41) + cells.astype(np.uint64))
+    labels[labels == np.uint64(2**64 - 41)] = 0  # one cell is background
+    store = zarr.open(str(tmp_path / "seg.zarr"), mode="w", shape=shape, chunks=(17, 13, 11), dtype=np.uint64)
+    store[:] = labels
+    source = zarr.open(str(tmp_path / "seg.zarr"), mode="r")
+
+    seen = []
+    out = tmp_path / "meshes"
+    work = tmp_path / "fragments"
+    figures = blocks.write_label_meshes(source, out, block=(34, 26, 22), spacing=(2.0, 1.5, 1.0),
+                                        client=client, work_dir=work,
+                                        progress=lambda stage, done, total: seen.append((stage, done, total)))
+    want = surftrack.label_surfaces(labels, spacing=(2.0, 1.5, 1.0))
+    assert sorted(figures) == sorted(want) and len(want) == 39
+    reference = tmp_path / "reference"
+    reference.mkdir()
+    for label, surface in want.items():
+        surface.write(str(reference / f"label_{label}.ply"))
+        assert (out / f"label_{label}.ply").read_bytes() == (reference / f"label_{label}.ply").read_bytes()
+        assert figures[label]["voxels"] == surface.voxels and figures[label]["euler"] == surface.euler
+    assert sorted(p.name for p in out.iterdir()) == sorted(p.name for p in reference.iterdir())
+    assert ("blocks", 12, 12) in seen and seen[-1][0] == "labels" and seen[-1][1] == seen[-1][2] == 39
+
+    # Resumed: every block's fragment file is there, so none is computed again.
+    stamps = {p.name: p.stat().st_mtime_ns for p in work.iterdir()}
+    assert len(stamps) == 12
+    again = tmp_path / "again"
+    blocks.write_label_meshes(source, again, block=(34, 26, 22), spacing=(2.0, 1.5, 1.0), client=client,
+                              work_dir=work)
+    assert {p.name: p.stat().st_mtime_ns for p in work.iterdir()} == stamps
+    for f in out.iterdir():
+        assert (again / f.name).read_bytes() == f.read_bytes()
+
+
+def test_a_worker_killed_mid_run_changes_nothing(client, tmp_path):
+    labels = random_labels(np.random.default_rng(17), (12, 11, 10))
+    marker = tmp_path / "killed-once"
+
+    class KillsItsWorkerOnce:
+        """Reads as the array does, but the first read of the block at the origin ends the
+        worker process (defined here, so that it is pickled by value)."""
+
+        def __init__(self, array, marker):
+            self.array, self.marker = array, str(marker)
+            self.shape, self.dtype = array.shape, array.dtype
+
+        def __getitem__(self, index):
+            if index[0].start == 0 and index[1].start == 0 and index[2].start == 0 and not os.path.exists(self.marker):
+                Path(self.marker).write_text("x")
+                os._exit(1)
+            return self.array[index]
+
+    got = blocks.label_surfaces(KillsItsWorkerOnce(labels, marker), block=(5, 4, 6), client=client)
+    assert marker.exists()
+    expect_same(got, surftrack.label_surfaces(labels))
+    client.wait_for_workers(2)
+
+
+def test_bad_input_is_refused_before_the_run(client, tmp_path):
+    labels = np.zeros((8, 8, 8), np.uint16)
+    labels[2:5, 2:5, 2:5] = 1
+    with pytest.raises(ValueError, match=r"use block=\("):
+        blocks.label_surfaces(labels, block=(1200, 1200, 1200), client=client)
+    with pytest.raises(ValueError, match="integer voxels"):
+        blocks.label_surfaces(labels.astype(np.float32), client=client)
+    with pytest.raises(ValueError, match="block"):
+        blocks.label_surfaces(labels, block=(0, 4, 4), client=client)
+    full = tmp_path / "full"
+    full.mkdir()
+    (full / "x").write_text("x")
+    with pytest.raises(ValueError, match="not an empty directory"):
+        blocks.write_label_meshes(labels, full, client=client)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["full"]
