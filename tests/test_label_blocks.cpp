@@ -156,6 +156,7 @@ TEST_P(LabelBlocks, MergedFragmentsAreTheSinglePass) {
   std::mt19937_64 rng(0xB10C5 + std::uint64_t(pair));
   auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
   int cases = 0, blocksSeen = 0, thinBlocks = 0, singleBlock = 0;
+  int apronOnly = 0;  // fragments of a label with triangles in the block's cubes but no voxel in its core
   std::map<Label, int> bigLabels;  // labels above 2^53 checked
   for (int iteration = 0; iteration < 1000; ++iteration) {
     const Label background = uniform(0, 9) == 0 ? kPool[std::size_t(uniform(0, int(std::size(kPool)) - 1))] : 0;
@@ -222,6 +223,7 @@ TEST_P(LabelBlocks, MergedFragmentsAreTheSinglePass) {
           for (std::size_t f = 0; f < got.size(); ++f) {
             if (f > 0) EXPECT_LT(got[f - 1].label, got[f].label);
             checkFragment(got[f], lo, hi);
+            if (got[f].voxels == 0) ++apronOnly;
             fragments[got[f].label.as<Label>()].push_back(got[f]);
           }
           for (int z = lo.z; z < hi.z; ++z)
@@ -249,8 +251,10 @@ TEST_P(LabelBlocks, MergedFragmentsAreTheSinglePass) {
   EXPECT_GE(cases, int(ref::subsetMinimum(900)));
   EXPECT_GE(thinBlocks, int(ref::subsetMinimum(1000)));
   EXPECT_GE(singleBlock, int(ref::subsetMinimum(40)));
+  EXPECT_GE(apronOnly, int(ref::subsetMinimum(1000)));
   EXPECT_TRUE(bigLabels.count(kTwo53 + 1) && bigLabels.count(std::numeric_limits<Label>::max()));
-  std::printf("%d cases, %d blocks (%d thin, %d single-block cases)\n", cases, blocksSeen, thinBlocks, singleBlock);
+  std::printf("%d cases, %d blocks (%d thin, %d single-block cases), %d fragments without core voxels\n", cases,
+              blocksSeen, thinBlocks, singleBlock, apronOnly);
 }
 
 INSTANTIATE_TEST_SUITE_P(Pairs, LabelBlocks, ::testing::ValuesIn(kAllAdjacencyPairs), ref::pairTestName);
