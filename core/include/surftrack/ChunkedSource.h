@@ -67,6 +67,8 @@ inline constexpr std::size_t kDefaultChunkCacheBytes = std::size_t(512) << 20;
 class ChunkCache {
  public:
   /// Throws InvalidInput for a null provider, a layout with empty or oversized dims or chunks.
+  /// Past `budgetBytes` of decoded chunks, the least recently used are freed down to 15/16 of
+  /// it; a budget of 0 (or below one chunk) keeps nothing beyond the chunks in use.
   explicit ChunkCache(std::shared_ptr<const ChunkProvider> provider,
                       std::size_t budgetBytes = kDefaultChunkCacheBytes);
   ~ChunkCache();
@@ -74,7 +76,9 @@ class ChunkCache {
   ChunkCache& operator=(const ChunkCache&) = delete;
 
   const ChunkLayout& layout() const;
-  /// Chunk `index`, decoded (from the cache or the provider).
+  /// Chunk `index`, decoded (from the cache or the provider). Rethrows the provider's
+  /// exception to every caller waiting on that read; a later call reads again. Throws
+  /// InvalidInput for an index outside the chunk grid.
   std::shared_ptr<const DecodedChunk> chunk(Voxel index) const;
   ChunkCacheCounters counters() const;
 
