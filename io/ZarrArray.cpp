@@ -129,7 +129,10 @@ class ZarrProvider final : public detail::GridProvider {
  protected:
   std::string chunkPath(const std::vector<std::int64_t>& coords) const override {
     std::string path = dir_ + '/';
-    for (std::size_t a = 0; a < coords.size(); ++a) path += (a ? std::string(1, separator_) : "") + std::to_string(coords[a]);
+    for (std::size_t a = 0; a < coords.size(); ++a) {
+      if (a) path += separator_;
+      path += std::to_string(coords[a]);
+    }
     return path;
   }
   Decoded decode(const std::string& bytes, const std::string& path) const override {
