@@ -165,7 +165,16 @@ std::uint64_t GridProvider::read(Voxel index, void* out) const {
     for (std::size_t i = 0; i < count; ++i) std::memcpy(dst + i * voxel, g.fill.data(), voxel);
     return 0;
   }
-  const Decoded chunk = decode(*stored, path);
+  // A 3D C-ordered chunk in the machine's byte order, whole inside the array, is the engine's
+  // chunk as it is stored: decoded straight into `out`, no copy.
+  const bool swap = voxel > 1 && g.bigEndian != (std::endian::native == std::endian::big);
+  bool inPlace = rank == 3 && !g.fortranOrder && !swap;
+  for (int e = 0; e < 3 && inPlace; ++e) inPlace = extent[e] == g.chunks[rank - 1 - e];
+  const Decoded chunk = decode(*stored, path, inPlace ? dst : nullptr);
+  if (!chunk.bytes) {
+    if (!inPlace || chunk.shape != g.chunks) throw std::logic_error("GridProvider: a chunk decoded in place unasked");
+    return stored->size();
+  }
   const std::string context = "cannot read chunk " + quotedPath(path);
   if (int(chunk.shape.size()) != rank) fail(context, "it holds " + std::to_string(chunk.shape.size()) + " dimensions, not " + std::to_string(rank));
   std::uint64_t count = 1;
@@ -192,7 +201,6 @@ std::uint64_t GridProvider::read(Voxel index, void* out) const {
   for (int a = 0; a < rank; ++a) base += std::size_t(start[a]) * stride[a];
   const std::size_t sx = stride[rank - 1], sy = stride[rank - 2];  // engine x, y (arrayAxisOf)
   const std::size_t sz = g.spatialAxes == 3 ? stride[rank - 3] : 0;
-  const bool swap = voxel > 1 && g.bigEndian != (std::endian::native == std::endian::big);
   const unsigned char* src = chunk.bytes.get();
   for (int z = 0; z < extent[2]; ++z)
     for (int y = 0; y < extent[1]; ++y) {

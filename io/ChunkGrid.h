@@ -67,7 +67,8 @@ class GridProvider : public ChunkProvider {
 
  protected:
   /// The decoded voxels of one chunk file: `shape` (numpy order, grid's memory and byte order)
-  /// and its bytes, exactly product(shape) voxels.
+  /// and its bytes, exactly product(shape) voxels; or, decoded in place (`bytes` null), the
+  /// chunk's voxels are in the caller's `direct` buffer already.
   struct Decoded {
     std::vector<std::int64_t> shape;
     std::unique_ptr<unsigned char[]> bytes;
@@ -76,8 +77,10 @@ class GridProvider : public ChunkProvider {
   /// The file of the chunk at `coords` (array chunk coordinates, numpy order).
   virtual std::string chunkPath(const std::vector<std::int64_t>& coords) const = 0;
   /// Decodes a chunk file's bytes; the shape may be smaller than the grid's chunks at the far
-  /// edges (N5) but must cover the array there. Throws ReadError naming `path`.
-  virtual Decoded decode(const std::string& bytes, const std::string& path) const = 0;
+  /// edges (N5) but must cover the array there. Throws ReadError naming `path`. When `direct`
+  /// is not null, a chunk whose shape is the grid's chunks may be decoded into it (its bytes
+  /// are then the engine's chunk as they are: GridProvider passes it only for those grids).
+  virtual Decoded decode(const std::string& bytes, const std::string& path, unsigned char* direct) const = 0;
 
  private:
   ChunkGrid grid_;

@@ -74,7 +74,7 @@ class N5Provider final : public detail::GridProvider {
     for (auto c = coords.rbegin(); c != coords.rend(); ++c) path += '/' + std::to_string(*c);
     return path;
   }
-  Decoded decode(const std::string& stored, const std::string& path) const override {
+  Decoded decode(const std::string& stored, const std::string& path, unsigned char* direct) const override {
     const std::string context = "cannot read block " + quotedPath(path);
     const auto* p = reinterpret_cast<const unsigned char*>(stored.data());
     const std::size_t rank = grid().shape.size();
@@ -102,8 +102,9 @@ class N5Provider final : public detail::GridProvider {
       bytes *= n;
     }
     d.size = std::size_t(bytes);
-    d.bytes = std::make_unique_for_overwrite<unsigned char[]>(d.size);
-    detail::decodeChunk(codec_, p + header, stored.size() - header, d.bytes.get(), d.size, context);
+    if (d.shape != grid().chunks) direct = nullptr;  // a clipped block: GridProvider copies it out
+    if (!direct) d.bytes = std::make_unique_for_overwrite<unsigned char[]>(d.size);
+    detail::decodeChunk(codec_, p + header, stored.size() - header, direct ? direct : d.bytes.get(), d.size, context);
     return d;
   }
 

@@ -135,13 +135,13 @@ class ZarrProvider final : public detail::GridProvider {
     }
     return path;
   }
-  Decoded decode(const std::string& bytes, const std::string& path) const override {
+  Decoded decode(const std::string& bytes, const std::string& path, unsigned char* direct) const override {
     Decoded d;
     d.shape = grid().chunks;
     d.size = std::size_t(detail::chunkBytes(grid()));
-    d.bytes = std::make_unique_for_overwrite<unsigned char[]>(d.size);
-    detail::decodeChunk(codec_, reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), d.bytes.get(), d.size,
-                        "cannot read chunk " + quotedPath(path));
+    if (!direct) d.bytes = std::make_unique_for_overwrite<unsigned char[]>(d.size);
+    detail::decodeChunk(codec_, reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), direct ? direct : d.bytes.get(),
+                        d.size, "cannot read chunk " + quotedPath(path));
     return d;
   }
 
