@@ -4,6 +4,7 @@
 // order; prints the layout and what was chosen as JSON on stdout. Errors: one line on stderr,
 // exit status 1.
 //   chunk_dump STORE OUT.raw [--level N] [--channel C] [--time T] [--threads K]
+//   chunk_dump --probe PATH      prints whether isChunkedStore(PATH): true or false
 #include <atomic>
 #include <cstdio>
 #include <cstring>
@@ -23,6 +24,10 @@ using namespace surftrack;
 namespace {
 
 int run(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--probe") {
+    std::cout << (io::isChunkedStore(argv[2]) ? "true" : "false") << "\n";
+    return 0;
+  }
   if (argc < 3) throw std::invalid_argument("usage: chunk_dump STORE OUT.raw [--level N] [--channel C] [--time T] [--threads K]");
   io::ChunkedStoreOptions options;
   int threads = 3;

@@ -501,3 +501,46 @@ def test_chunk_that_is_a_directory(tmp_path):
     os.remove(path / "1.0.0")
     (path / "1.0.0").mkdir()
     expect_refused(path, tmp_path, says=["cannot read chunk '", "/1.0.0': it is not a regular file"])
+
+
+def probe(path):
+    r = subprocess.run([EXE, "--probe", str(path)], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    return json.loads(r.stdout)
+
+
+def test_recognised_stores(tmp_path):
+    """isChunkedStore: the three kinds of store (a trailing slash too), nothing else."""
+    zarr_array, data = small_store(tmp_path)
+    write_ome(tmp_path / "ome", [data], [{"name": n, "type": "space"} for n in "zyx"],
+              [[{"type": "scale", "scale": [1.0, 1.0, 1.0]}]], None)
+    z = zarr.create(store=zarr.N5Store(str(tmp_path / "c.n5")), path="v", shape=(4, 4, 4), dtype="u1")
+    z[...] = 1
+    for path in [zarr_array, tmp_path / "ome", tmp_path / "c.n5" / "v"]:
+        assert probe(path) and probe(str(path) + "/")
+    expect_voxels(*dump(str(zarr_array) + "/", tmp_path), data)
+    zarr.open_group(str(tmp_path / "g.zarr"), mode="w")
+    (tmp_path / "empty").mkdir()
+    for path in [tmp_path / "c.n5", tmp_path / "g.zarr", tmp_path / "empty", tmp_path / "nothing",
+                 zarr_array / "0.0.0", tmp_path / "ome" / "s0" / "0.0.0"]:
+        assert not probe(path)
+    # Damaged metadata is still a store: opening it says what is wrong.
+    (zarr_array / ".zarray").write_text("{")
+    assert probe(zarr_array)
+
+
+def test_ome_zarr_time_series_of_slices(tmp_path):
+    data = random_array("<f8", (3, 10, 9), seed=6)
+    axes = [{"name": "t", "type": "time", "unit": "second"},
+            {"name": "y", "type": "space", "unit": "nanometer"}, {"name": "x", "type": "space", "unit": "nanometer"}]
+    root = zarr.open_group(str(tmp_path / "ts.zarr"), mode="w")
+    root.create_dataset("0", data=data, chunks=(2, 4, 4), compressor=compressor(("zstd",)))
+    root.attrs["multiscales"] = [{"version": "0.4", "axes": axes, "datasets": [
+        {"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [60.0, 4.0, 2.5]},
+                                                    {"type": "translation", "translation": [0.0, 1.0, -1.0]}]}]}]
+    for t in range(3):
+        report, raw = dump(tmp_path / "ts.zarr", tmp_path, "--time", t)
+        expect_voxels(report, raw, data[t])
+        assert report["dims"] == [9, 10, 1] and report["unit"] == "nanometer"
+        assert report["spacing"] == [2.5, 4.0, 1.0] and report["origin"] == [-1.0, 1.0, 0.0]
+        assert report["chosen"] == [{"name": "t", "index": t, "size": 3}]
