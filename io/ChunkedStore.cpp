@@ -57,7 +57,7 @@ std::vector<std::int64_t> chooseLeading(const std::vector<std::string>& names, c
       throw ReadError("cannot read " + quotedPath(path) + ": " + kinds[a] + " " + std::to_string(index) + " is outside its axis '" +
                       names[a] + "' of " + std::to_string(shape[a]) + " (0 to " + std::to_string(shape[a] - 1) + ")");
     fixed.push_back(index);
-    chosen.push_back({names[a], index, shape[a]});
+    chosen.push_back({names[a], kinds[a], index, shape[a]});
   }
   if (options.channel && !usedChannel)
     throw ReadError("cannot read " + quotedPath(path) + ": a channel is chosen (" + std::to_string(*options.channel) + ") but the array has no channel axis");

@@ -27,6 +27,7 @@ struct ChunkedStoreOptions {
 /// A leading axis of the array and the index read along it.
 struct AxisChoice {
   std::string name;  ///< OME-Zarr's axis name; "c" (channel) or "t" (time) otherwise
+  std::string type;  ///< "channel", "time", or OME-Zarr's other type ("index" when none is stated)
   std::int64_t index = 0, size = 1;
 };
 

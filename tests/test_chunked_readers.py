@@ -344,6 +344,7 @@ def test_ome_zarr_levels_and_composed_transforms(tmp_path):
             assert report["unit"] == "micrometer" and report["format"] == "ome-zarr"
             assert report["level"] == k and report["levels"] == 3
             assert report["choice"] == f"level {k} of 3, c {c} of 2"
+            assert report["channel"] == c and report["channels"] == 2
             assert report["array"].endswith(f"image.ome.zarr/s{k}")
     expect_refused(path, tmp_path, "--level", 3, says=["level 3 is outside its 3 levels (0 to 2)"])
     expect_refused(path, tmp_path, "--channel", 2, says=["channel 2 is outside its axis 'c' of 2"])
