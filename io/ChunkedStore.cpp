@@ -104,7 +104,8 @@ bool isChunkedStore(const std::string& path) {
   const std::string dir = trimmed(path);
   if (!isDirectory(dir)) return false;
   try {
-    return isFile(dir + "/.zarray") || isOmeZarr(dir) || isN5Dataset(dir);
+    // Groups too: openChunkedStore names their arrays.
+    return isFile(dir + "/.zarray") || isFile(dir + "/.zgroup") || isFile(dir + "/attributes.json") || isOmeZarr(dir);
   } catch (const ReadError&) {
     return true;  // a store's metadata, damaged: openChunkedStore says how
   }

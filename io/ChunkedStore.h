@@ -46,8 +46,8 @@ struct ChunkedStore {
 };
 
 /// Whether `path` is a directory holding a zarr array (.zarray), an OME-Zarr image (.zattrs
-/// with multiscales) or an N5 dataset (attributes.json with dimensions). Never throws for a
-/// path that is not one.
+/// with multiscales), an N5 dataset (attributes.json), or a zarr (.zgroup) or N5 group, which
+/// openChunkedStore refuses naming their arrays. Never throws.
 bool isChunkedStore(const std::string& path);
 
 /// Opens the store at `path`. Throws ReadError, one line naming the path: not a directory, not

@@ -65,7 +65,7 @@ LoadedVolume loadChunkedStore(const ChunkedStore& store, int threads, ChunkedLoa
   out.format = store.format;
   out.unit = store.unit;
   out.dataBytes = bytes;
-  out.decodeReason = "its " + std::to_string(grid.count()) + " chunks decoded (" + store.compressor + ")";
+  out.decodeReason = "its " + std::to_string(grid.count()) + " chunks decoded whole, compressor " + store.compressor;
   for (const AxisChoice& a : store.chosen)
     if (a.type == "channel") out.channel = int(a.index), out.channels = int(a.size);
   if (counts) *counts = {grid.count(), missing.load(), bytesRead.load()};

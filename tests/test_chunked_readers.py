@@ -5,7 +5,8 @@ with the arrays numpy holds: every codec and shuffle, the ten voxel types in bot
 C and F order, both dimension separators, missing chunks, shapes that chunks do not divide,
 leading time and channel axes, OME-Zarr levels and their composed transformations; what
 cannot be read refused with one line and exit status 1. Run by ctest (tests/CMakeLists.txt)
-with SURFTRACK_CHUNK_DUMP set to the tool."""
+with SURFTRACK_CHUNK_DUMP set to the tool, and SURFTRACK_EXE to the command-line tool, which reads
+a store whole (its meshes are those of the same voxels in a raw file)."""
 import gzip
 import json
 import os
@@ -511,18 +512,18 @@ def probe(path):
 
 
 def test_recognised_stores(tmp_path):
-    """isChunkedStore: the three kinds of store (a trailing slash too), nothing else."""
+    """isChunkedStore: the three kinds of store (a trailing slash too) and their groups, nothing else."""
     zarr_array, data = small_store(tmp_path)
     write_ome(tmp_path / "ome", [data], [{"name": n, "type": "space"} for n in "zyx"],
               [[{"type": "scale", "scale": [1.0, 1.0, 1.0]}]], None)
     z = zarr.create(store=zarr.N5Store(str(tmp_path / "c.n5")), path="v", shape=(4, 4, 4), dtype="u1")
     z[...] = 1
-    for path in [zarr_array, tmp_path / "ome", tmp_path / "c.n5" / "v"]:
+    zarr.open_group(str(tmp_path / "g.zarr"), mode="w")
+    for path in [zarr_array, tmp_path / "ome", tmp_path / "c.n5" / "v", tmp_path / "c.n5", tmp_path / "g.zarr"]:
         assert probe(path) and probe(str(path) + "/")
     expect_voxels(*dump(str(zarr_array) + "/", tmp_path), data)
-    zarr.open_group(str(tmp_path / "g.zarr"), mode="w")
     (tmp_path / "empty").mkdir()
-    for path in [tmp_path / "c.n5", tmp_path / "g.zarr", tmp_path / "empty", tmp_path / "nothing",
+    for path in [tmp_path / "empty", tmp_path / "nothing",
                  zarr_array / "0.0.0", tmp_path / "ome" / "s0" / "0.0.0"]:
         assert not probe(path)
     # Damaged metadata is still a store: opening it says what is wrong.
@@ -545,3 +546,46 @@ def test_ome_zarr_time_series_of_slices(tmp_path):
         assert report["dims"] == [9, 10, 1] and report["unit"] == "nanometer"
         assert report["spacing"] == [2.5, 4.0, 1.0] and report["origin"] == [-1.0, 1.0, 0.0]
         assert report["chosen"] == [{"name": "t", "index": t, "size": 3}]
+
+
+# --- The command-line tool reads stores whole ----------------------------------------------------
+
+CLI = os.environ.get("SURFTRACK_EXE", "build/cli/surftrack")
+
+
+def surftrack(*args):
+    if not os.path.exists(CLI):
+        pytest.skip("the command-line tool is not built")
+    return subprocess.run([CLI, *map(str, args)], capture_output=True, text=True, timeout=120)
+
+
+def test_cli_meshes_a_store_as_the_same_voxels_in_a_raw_file(tmp_path):
+    z, y, x = np.mgrid[:40, :36, :32]
+    ball = np.where((x - 15.3) ** 2 + (y - 17.6) ** 2 / 1.5 + (z - 19.2) ** 2 < 12 ** 2, 200, 10).astype("<u2")
+    channels = np.stack([ball // 2, ball])  # c, z, y, x
+    axes = [{"name": "c", "type": "channel"}] + [{"name": n, "type": "space", "unit": "micrometer"} for n in "zyx"]
+    store = tmp_path / "ball.ome.zarr"
+    write_ome(store, [channels, channels[:, ::2, ::2, ::2]], axes,
+              [[{"type": "scale", "scale": [1.0, 2.0 * f, 1.0 * f, 0.5 * f]},
+                {"type": "translation", "translation": [0.0, 3.0, -4.0, 5.0]}] for f in (1, 2)], None)
+    for level, channel in [(0, 1), (1, 1), (1, 0)]:
+        data = channels[channel][:: 2 ** level, :: 2 ** level, :: 2 ** level]
+        data.tofile(tmp_path / "ball.raw")
+        f = 2 ** level
+        r = surftrack("mesh", store, "--level", level, "--channel", channel, "-o", tmp_path / "a.ply", "--iso", 60, "--json")
+        assert r.returncode == 0, r.stderr
+        raw = surftrack("mesh", tmp_path / "ball.raw", "--raw-dims", "{},{},{}".format(*data.shape[::-1]), "--raw-type",
+                        "uint16", "--spacing", "{},{},{}".format(0.5 * f, 1.0 * f, 2.0 * f), "--origin", "5,-4,3",
+                        "-o", tmp_path / "b.ply", "--iso", 60)
+        assert raw.returncode == 0, raw.stderr
+        assert (tmp_path / "a.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
+    r = surftrack("info", store, "--json", "--channel", 1)
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout)
+    assert info["dims"] == [32, 36, 40] and info["unit"] == "micrometer" and info["channel"] == 1
+    assert info["spacing"] == [0.5, 1.0, 2.0] and info["origin"] == [5.0, -4.0, 3.0]
+    for args, says in [((store, "--level", 2), "level 2 is outside its 2 levels"),
+                       ((store, "--time", 0), "no time axis"),
+                       ((tmp_path / "ball.raw", "--raw-dims", "1,1,1", "--raw-type", "uint8", "--level", 1), "--level and --time")]:
+        r = surftrack("info", *args)
+        assert r.returncode == 1 and r.stderr.count("\n") == 1 and says in r.stderr, r.stderr
