@@ -168,7 +168,7 @@ std::uint64_t GridProvider::read(Voxel index, void* out) const {
   // A 3D C-ordered chunk in the machine's byte order, whole inside the array, is the engine's
   // chunk as it is stored: decoded straight into `out`, no copy.
   const bool swap = voxel > 1 && g.bigEndian != (std::endian::native == std::endian::big);
-  bool inPlace = rank == 3 && !g.fortranOrder && !swap;
+  bool inPlace = rank == 3 && g.spatialAxes == 3 && !g.fortranOrder && !swap;
   for (int e = 0; e < 3 && inPlace; ++e) inPlace = extent[e] == g.chunks[rank - 1 - e];
   const Decoded chunk = decode(*stored, path, inPlace ? dst : nullptr);
   if (!chunk.bytes) {
