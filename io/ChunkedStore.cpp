@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "ChunkGrid.h"
 #include "N5Dataset.h"
 #include "OmeZarr.h"
@@ -111,8 +113,9 @@ bool isChunkedStore(const std::string& path) {
   }
 }
 
-ChunkedStore openChunkedStore(const std::string& rawPath, const ChunkedStoreOptions& options) {
-  const std::string path = trimmed(rawPath);
+namespace {
+
+ChunkedStore openStore(const std::string& path, const ChunkedStoreOptions& options) {
   if (!isDirectory(path))
     throw ReadError("cannot read " + quotedPath(path) + ": " + (isFile(path) ? "a file" : "no such directory") +
                     "; a chunked store is a directory (a zarr array, an OME-Zarr image or an N5 dataset)");
@@ -176,6 +179,19 @@ ChunkedStore openChunkedStore(const std::string& rawPath, const ChunkedStoreOpti
   if (isFile(path + "/attributes.json"))
     throw ReadError("cannot read " + quotedPath(path) + ": an N5 group; name one of its datasets (" + childrenWith(path, "attributes.json") + ")");
   throw ReadError("cannot read " + quotedPath(path) + ": not a zarr array (.zarray), an OME-Zarr image (.zattrs with multiscales) or an N5 dataset (attributes.json)");
+}
+
+}  // namespace
+
+ChunkedStore openChunkedStore(const std::string& rawPath, const ChunkedStoreOptions& options) {
+  const std::string path = trimmed(rawPath);
+  try {
+    return openStore(path, options);
+  } catch (const nlohmann::json::exception& e) {
+    // The readers check each field they read; a JSON library error here is one they missed,
+    // still one line naming the store.
+    throw ReadError("cannot read " + quotedPath(path) + ": malformed metadata (" + e.what() + ")");
+  }
 }
 
 }  // namespace surftrack::io

@@ -41,7 +41,7 @@ ChunkCodec parseCompression(const json& m, const std::string& context) {
   if (type == "raw") {
     codec.description = "none";
   } else if (type == "gzip") {
-    const bool zlib = c.value("useZlib", false) == true;
+    const bool zlib = c.contains("useZlib") && c["useZlib"] == true;
     codec.kind = zlib ? ChunkCodec::Kind::Zlib : ChunkCodec::Kind::Gzip;
     codec.description = zlib ? "zlib" : "gzip";
   } else if (type == "zstd") {

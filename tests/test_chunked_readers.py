@@ -288,6 +288,10 @@ def test_n5_bad_blocks(tmp_path):
         meta.update(attrs)
         (path / "attributes.json").write_text(json.dumps(meta))
         expect_refused(path, tmp_path, says=[says, "attributes.json'"])
+    # A useZlib that is not a boolean is not true: gzip, which the raw block is not.
+    meta["compression"] = {"type": "gzip", "useZlib": {"x": 1}}
+    (path / "attributes.json").write_text(json.dumps(meta))
+    expect_refused(path, tmp_path, says=["corrupt or truncated gzip data", "/0/0/0'"])
 
 
 # --- OME-Zarr ----------------------------------------------------------------------------------
