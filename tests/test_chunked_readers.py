@@ -593,3 +593,58 @@ def test_cli_meshes_a_store_as_the_same_voxels_in_a_raw_file(tmp_path):
                        ((tmp_path / "ball.raw", "--raw-dims", "1,1,1", "--raw-type", "uint8", "--level", 1), "--level and --time")]:
         r = surftrack("info", *args)
         assert r.returncode == 1 and r.stderr.count("\n") == 1 and says in r.stderr, r.stderr
+
+
+MUTANTS = [None, 0, -1, 1, 3, 2 ** 31, 2 ** 63, -2 ** 63, 2 ** 64 - 1, 1.5, 1e300, "NaN", "", "x", [], [1], [0, 0, 0],
+           [2 ** 40, 1, 1], {}, {"id": "blosc"}, {"type": "gzip"}, True, "<u2", "|u1", ">f8", "F", "/", [[1]], "0.4",
+           {"type": "scale", "scale": [1, 1, 1]}]
+
+
+def mutate(obj, rng, depth=0):
+    """Replaces, deletes or appends one value somewhere in a JSON document."""
+    keys = list(obj) if isinstance(obj, dict) else list(range(len(obj)))
+    if not keys:
+        return
+    k = keys[int(rng.integers(len(keys)))]
+    r = rng.random()
+    if r < 0.15:
+        del obj[k]
+    elif r < 0.5 and isinstance(obj[k], (dict, list)) and obj[k] and depth < 4:
+        mutate(obj[k], rng, depth + 1)
+    elif r < 0.6 and isinstance(obj, list):
+        obj.append(json.loads(json.dumps(MUTANTS[int(rng.integers(len(MUTANTS)))])))
+    else:
+        obj[k] = json.loads(json.dumps(MUTANTS[int(rng.integers(len(MUTANTS)))]))
+
+
+def test_random_metadata_mutations(tmp_path):
+    """Metadata of each kind of store mutated at random (fixed seed): read, or refused with one
+    line, never a crash."""
+    rng = np.random.default_rng(2024)
+    data = np.arange(2 * 6 * 5 * 4, dtype="<u2").reshape(2, 6, 5, 4)
+    for trial in range(90):
+        path = tmp_path / f"m{trial}"
+        kind = trial % 3
+        if kind == 0:
+            write_zarr(path, data, ("blosc", "lz4", 1), chunks=(1, 3, 2, 4))
+            meta, store = path / ".zarray", path
+        elif kind == 1:
+            axes = [{"name": "c", "type": "channel"}] + [{"name": n, "type": "space", "unit": "um"} for n in "zyx"]
+            write_ome(path, [data], axes, [[{"type": "scale", "scale": [1, 2, 3, 4]},
+                                            {"type": "translation", "translation": [0, 1, 2, 3]}]],
+                      [{"type": "scale", "scale": [1, 1, 1, 1]}])
+            meta, store = path / ".zattrs", path
+        else:
+            z = zarr.create(store=zarr.N5Store(str(path)), path="d", shape=data.shape, chunks=(1, 3, 2, 4),
+                            dtype="<u2", compressor=numcodecs.GZip())
+            z[...] = data
+            meta, store = path / "d" / "attributes.json", path / "d"
+        doc = json.loads(meta.read_text())
+        for _ in range(int(rng.integers(1, 4))):
+            mutate(doc, rng)
+        meta.write_text(json.dumps(doc))
+        args = [[], ["--channel", 1], ["--level", 1], ["--time", 0]][trial // 3 % 4]
+        r, _ = run(store, tmp_path, *args)
+        assert r.returncode in (0, 1), (doc, r.stderr)
+        if r.returncode == 1:
+            assert r.stderr.count("\n") == 1 and r.stderr.startswith("chunk_dump: error: cannot read "), (doc, r.stderr)
