@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "ChunkedStore.h"
 #include "Extract.h"
 #include "VolumeStats.h"
 
@@ -60,8 +61,20 @@ void describeInput(const io::LoadedVolume& volume, const std::string& path, Extr
 io::LoadedVolume readInput(const InputOptions& input) {
   io::ReadOptions options;
   options.channel = input.channel;
-  io::LoadedVolume volume = input.raw ? io::loadRawVolume(input.path, input.rawLayout)
-                                      : io::loadVolume(input.path, options);
+  const bool store = !input.raw && io::isChunkedStore(input.path);
+  if (!store && (input.level || input.time))
+    throw io::ReadError("cannot read '" + input.path + "': --level and --time choose in a chunked store (zarr, OME-Zarr, N5), which it is not");
+  io::LoadedVolume volume;
+  if (store) {
+    // Read whole for now: every chunk decoded into one buffer (docs/cli.md, "Input formats").
+    io::ChunkedStoreOptions chosen;
+    chosen.level = input.level.value_or(0);
+    chosen.channel = input.channel;
+    chosen.time = input.time;
+    volume = io::loadChunkedStore(io::openChunkedStore(input.path, chosen));
+  } else {
+    volume = input.raw ? io::loadRawVolume(input.path, input.rawLayout) : io::loadVolume(input.path, options);
+  }
   if (input.raw && input.channel && *input.channel != 0)
     throw io::ReadError("cannot read '" + input.path + "': there is no channel " + std::to_string(*input.channel) +
                         " (--channel): a raw file has one channel, 0");

@@ -293,10 +293,22 @@ InputArgs addInputOptions(CLI::App& app, InputOptions& in) {
                         [](const std::string& s) { return "expected lps or ras, got '" + s + "'"; }))
       ->group("geometry override");
   app.add_option("--channel", in.channel,
-                 "the channel to read, from 0, of a multi-channel TIFF stack\n(ImageJ or OME-TIFF)")
+                 "the channel to read, from 0, of a multi-channel TIFF stack\n(ImageJ or OME-TIFF) or a chunked store (default 0)")
       ->option_text("C")
       ->check(explained(CLI::Range(0, 1 << 30), [](const std::string& s) {
         return "expected a channel number from 0, got '" + s + "'";
+      }))
+      ->group("input and output");
+  app.add_option("--level", in.level, "the resolution level of an OME-Zarr image, from 0 (default: 0, the finest)")
+      ->option_text("L")
+      ->check(explained(CLI::Range(0, 1 << 30), [](const std::string& s) {
+        return "expected a level number from 0, got '" + s + "'";
+      }))
+      ->group("input and output");
+  app.add_option("--time", in.time, "the time point to read, from 0, of a chunked store with a time axis (default 0)")
+      ->option_text("T")
+      ->check(explained(CLI::Range(0, 1 << 30), [](const std::string& s) {
+        return "expected a time point from 0, got '" + s + "'";
       }))
       ->group("input and output");
   return a;
@@ -327,7 +339,8 @@ void addOutputOptions(CLI::App& app, OutputOptions& out) {
 void addInput(CLI::App& app, InputOptions& in) {
   app.add_option("INPUT", in.path,
                  ".nii .nii.gz .nrrd .nhdr .mha .mhd .dcm .tif .vtk, a directory with\n"
-                 "one DICOM series, or a raw file with --raw-dims and --raw-type")
+                 "one DICOM series, a zarr, OME-Zarr or N5 directory, or a raw file\n"
+                 "with --raw-dims and --raw-type")
       ->type_name("")
       ->group("input and output");
 }

@@ -35,7 +35,9 @@ struct InputOptions {
   std::optional<std::array<double, 3>> spacing;  ///< --spacing
   std::optional<std::array<double, 3>> origin;   ///< --origin
   bool ras = false;  ///< --frame ras: physical coordinates in RAS (nibabel, MNI), not ITK's LPS
-  std::optional<int> channel;                    ///< --channel C: of a multi-channel TIFF stack
+  std::optional<int> channel;                    ///< --channel C: of a multi-channel TIFF stack or a chunked store
+  std::optional<int> level;                      ///< --level L: of an OME-Zarr image (io/ChunkedStore.h)
+  std::optional<int> time;                       ///< --time T: of a chunked store with a time axis
 };
 
 enum class SeedMode { Largest, All, Voxel, Ray, Surfel, Point };

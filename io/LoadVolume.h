@@ -34,6 +34,8 @@
 
 namespace surftrack::io {
 
+struct ChunkedStore;  // io/ChunkedStore.h
+
 /// A volume ready for the engine: a view of its voxels and what keeps their memory alive.
 /// Copies share the memory; the view stays valid as long as one copy of `owner` lives (even
 /// after the file is deleted: a mapping outlives its file's name).
@@ -93,5 +95,19 @@ LoadedVolume loadVolume(const std::string& path, const ReadOptions& options = {}
 /// headerBytes is a multiple of the voxel size; read into one buffer (and byte-swapped)
 /// otherwise. Throws ReadError, with readRawVolume's messages.
 LoadedVolume loadRawVolume(const std::string& path, const RawLayout& layout);
+
+/// The bytes and chunks a whole chunked store took to load.
+struct ChunkedLoadCounts {
+  std::uint64_t chunks = 0;         ///< chunks decoded
+  std::uint64_t missingChunks = 0;  ///< of which the store holds no file (the fill value)
+  std::uint64_t bytesRead = 0;      ///< from storage
+};
+
+/// Loads a chunked store (openChunkedStore, io/ChunkedStore.h) whole: every chunk decoded
+/// through its provider's read(), on `threads` threads (0: every core), into one buffer, x
+/// fastest. format "zarr", "ome-zarr" or "n5", unit (OME-Zarr's), channel and channels (the
+/// channel axis's, if any); decodeReason says the chunks were decoded. Throws the provider's
+/// ReadError (the first chunk that fails).
+LoadedVolume loadChunkedStore(const ChunkedStore& store, int threads = 0, ChunkedLoadCounts* counts = nullptr);
 
 }  // namespace surftrack::io

@@ -12,6 +12,7 @@ packages=(
   libinsighttoolkit5-dev         # ITK: NIfTI / NRRD / MetaImage / DICOM volumes for the CLI
   libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip streams)
   libdeflate-dev pkg-config      # io/: a .nii.gz inflated in one call
+  libblosc-dev libzstd-dev       # io/: the chunks of zarr and N5 stores (blosc, zstd)
   libcli11-dev                   # CLI11: the command line
   nlohmann-json3-dev             # nlohmann-json: the CLI's JSON output
   libtbb-dev                     # oneTBB: the scanning method on every core
@@ -21,7 +22,7 @@ packages=(
   python3-venv python3-pip python3-setuptools  # 'pip install --no-build-isolation .' in a venv
   python3-tifffile               # TIFF stacks (ImageJ, OME-TIFF) written independently for tests/test_tiff_stacks.py
   python3-dask python3-distributed  # surftrack.distributed: every label by blocks on a Dask cluster
-  python3-zarr                   # zarr stores for surftrack.distributed and its tests
+  python3-zarr python3-numcodecs # zarr, OME-Zarr and N5 stores written independently for the tests (readers, Dask)
   mricron-data                   # real MRI volumes used by the demo and one test
 )
 
