@@ -58,27 +58,23 @@ void describeInput(const io::LoadedVolume& volume, const std::string& path, Extr
   x.voxelBytes = volume.view.dims.count() * sizeOf(volume.view.type);
 }
 
-io::LoadedVolume readInput(const InputOptions& input) {
-  io::ReadOptions options;
-  options.channel = input.channel;
+io::ChunkedStoreOptions chunkedStoreOptions(const InputOptions& input) {
+  io::ChunkedStoreOptions chosen;
+  chosen.level = input.level.value_or(0);
+  chosen.channel = input.channel;
+  chosen.time = input.time;
+  return chosen;
+}
+
+bool isChunkedInput(const InputOptions& input) {
   const bool store = !input.raw && io::isChunkedStore(input.path);
   if (!store && (input.level || input.time))
     throw io::ReadError("cannot read '" + input.path + "': --level and --time choose in a chunked store (zarr, OME-Zarr, N5), which it is not");
-  io::LoadedVolume volume;
-  if (store) {
-    // Read whole for now: every chunk decoded into one buffer (docs/cli.md, "Input formats").
-    io::ChunkedStoreOptions chosen;
-    chosen.level = input.level.value_or(0);
-    chosen.channel = input.channel;
-    chosen.time = input.time;
-    volume = io::loadChunkedStore(io::openChunkedStore(input.path, chosen));
-  } else {
-    volume = input.raw ? io::loadRawVolume(input.path, input.rawLayout) : io::loadVolume(input.path, options);
-  }
-  if (input.raw && input.channel && *input.channel != 0)
-    throw io::ReadError("cannot read '" + input.path + "': there is no channel " + std::to_string(*input.channel) +
-                        " (--channel): a raw file has one channel, 0");
-  ImageGeometry& g = volume.view.geometry;
+  return store;
+}
+
+std::string applyGeometryOptions(const InputOptions& input, ImageGeometry& g, const std::string& frame) {
+  std::string out = frame;
   if (input.ras) {
     // RAS = diag(-1, -1, 1) LPS: the origin and the direction's x and y rows negated. The
     // handedness flips with them; the engine keeps the normals outwards (Extract.h, Surface).
@@ -86,10 +82,28 @@ io::LoadedVolume readInput(const InputOptions& input) {
       g.origin[r] = -g.origin[r];
       for (double& d : g.direction[r]) d = -d;
     }
-    volume.frame = "RAS";
+    out = "RAS";
   }
   if (input.spacing) g.spacing = *input.spacing;
   if (input.origin) g.origin = *input.origin;  // in the chosen frame
+  return out;
+}
+
+io::LoadedVolume readInput(const InputOptions& input) {
+  io::ReadOptions options;
+  options.channel = input.channel;
+  io::LoadedVolume volume;
+  if (isChunkedInput(input)) {
+    // Every chunk decoded into one buffer (docs/cli.md, "Input formats"); a seeded `mesh` reads
+    // a store lazily instead (MeshCommand.cpp).
+    volume = io::loadChunkedStore(io::openChunkedStore(input.path, chunkedStoreOptions(input)));
+  } else {
+    volume = input.raw ? io::loadRawVolume(input.path, input.rawLayout) : io::loadVolume(input.path, options);
+  }
+  if (input.raw && input.channel && *input.channel != 0)
+    throw io::ReadError("cannot read '" + input.path + "': there is no channel " + std::to_string(*input.channel) +
+                        " (--channel): a raw file has one channel, 0");
+  volume.frame = applyGeometryOptions(input, volume.view.geometry, volume.frame);
   return volume;
 }
 
@@ -159,6 +173,18 @@ VolumeStats valueStats(const VolumeView& volume, const Extraction& x) {
 
 void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extraction& x,
                     StageClock& clock, Progress& progress, int stage, int stageCount) {
+  const std::unique_ptr<VoxelSource> source = makeViewSource(volume);
+  extractSurface(*source, &volume, o, x, clock, progress, stage, stageCount);
+}
+
+void extractSurface(const VoxelSource& source, const VolumeView* whole, const SurfaceOptions& o, Extraction& x,
+                    StageClock& clock, Progress& progress, int stage, int stageCount) {
+  // What needs every voxel (the data range of the scans, Otsu's default, the explanation of an
+  // empty selection) needs `whole`; a lazy source is only ever seeded, with --iso or --label.
+  auto everyVoxel = [&]() -> const VolumeView& {
+    if (!whole) throw std::logic_error("extractSurface: every voxel asked of a lazy source");
+    return *whole;
+  };
   progress.stage(stage, stageCount, "choosing the voxels");
   x.pair = o.pair;
   x.seedMode = o.seedMode;
@@ -170,7 +196,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
     // The scanning rules read every voxel anyway: one more pass checks the iso-value against
     // the data range (a seeded extraction leaves that to its seed rule's own error).
     if (o.seedMode == SeedMode::Largest || o.seedMode == SeedMode::All) {
-      const auto range = valueRange(volume);
+      const auto range = valueRange(everyVoxel());
       if (!range) throw std::runtime_error("'" + x.input + "' holds no finite value: nothing to extract");
       x.dataRange = range;
       const std::string text = "[" + formatNumber((*range)[0]) + ", " + formatNumber((*range)[1]) + "]";
@@ -183,7 +209,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
     }
   } else {
     // Otsu's threshold is the one default that needs every value.
-    const VolumeStats stats = valueStats(volume, x);
+    const VolumeStats stats = valueStats(everyVoxel(), x);
     if (stats.min == stats.max)
       throw std::runtime_error("'" + x.input + "' is constant (every voxel is " + formatNumber(stats.min) +
                                "): there is no surface to extract");
@@ -209,11 +235,12 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   if (o.seedMode == SeedMode::Point) x.seedPoint = o.seedPoint;
   Surface surface;
   try {
-    surface = extract(volume, eo);
+    surface = whole ? extract(*whole, eo) : extract(source, eo);
   } catch (const SeedTooFar& e) {
     throw std::runtime_error(e.what());  // no pass over the volume: the search read only near the seed
   } catch (const InvalidInput& e) {
-    explainNoSurface(volume, x, e.what());
+    if (!whole) throw std::runtime_error(e.what());  // (a lazy source is not read whole to say more)
+    explainNoSurface(*whole, x, e.what());
   }
   x.warnings.insert(x.warnings.end(), surface.warnings.begin(), surface.warnings.end());
   x.seedDistance = surface.seed.distance;
@@ -227,7 +254,7 @@ void extractSurface(const VolumeView& volume, const SurfaceOptions& o, Extractio
   x.walkSteps = surface.seed.walkSteps;
   x.boundaries = surface.boundariesInImage;
   x.surfels = surface.surfels.size();
-  x.voxelBytesRead = x.mapped ? std::min<std::uintmax_t>(surface.voxelsRead * sizeOf(volume.type), x.voxelBytes)
+  x.voxelBytesRead = x.mapped ? std::min<std::uintmax_t>(surface.voxelsRead * sizeOf(source.type()), x.voxelBytes)
                              : x.voxelBytes;
   for (const ComponentFigures& c : surface.components) x.extractedVolume += c.volume;
   const int next = stage + extractionStages(o) - 1 - (o.refine.smoothIterations > 0) - o.refine.decimate();

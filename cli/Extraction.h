@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "ChunkedStore.h"
 #include "MeshStats.h"
 #include "Options.h"
 #include "Progress.h"
@@ -59,6 +60,9 @@ struct Extraction {
   std::optional<std::array<double, 2>> dataRange;
   /// How the voxels are held: memory-mapped from the file (read on demand) or decoded once.
   std::string storage;            ///< "memory-mapped mha", "loaded nii.gz", "in memory", ...
+  /// A chunked store read lazily: the chunks in the array, and what the cache did.
+  std::uint64_t chunkCount = 0;
+  std::optional<ChunkCacheCounters> chunks;
   bool mapped = false;            ///< memory-mapped: only the pages the engine touches are read
   std::string decodeReason;       ///< why the file was loaded whole rather than mapped
   std::uintmax_t voxelBytes = 0;  ///< nx ny nz sizeof(type)
@@ -119,6 +123,19 @@ int extractionStages(const SurfaceOptions& options);
 void extractSurface(const VolumeView& volume, const SurfaceOptions& options,
                     Extraction& extraction, StageClock& clock, Progress& progress,
                     int stageOffset, int stageCount);
+/// The same through any source; `whole` the view of every voxel, or null for a source read
+/// lazily (a chunked store): then only seeded extractions with --iso or --label.
+void extractSurface(const VoxelSource& source, const VolumeView* whole, const SurfaceOptions& options,
+                    Extraction& extraction, StageClock& clock, Progress& progress,
+                    int stageOffset, int stageCount);
+
+/// Whether the input is a chunked store (zarr, OME-Zarr, N5); --level and --time are refused
+/// for any other input.
+bool isChunkedInput(const InputOptions& input);
+/// The level, channel and time to read in a chunked store.
+io::ChunkedStoreOptions chunkedStoreOptions(const InputOptions& input);
+/// Applies --frame ras, --spacing and --origin to `geometry`; returns the frame.
+std::string applyGeometryOptions(const InputOptions& input, ImageGeometry& geometry, const std::string& frame);
 
 /// Fills the input fields of `extraction` from `volume`.
 void describeInput(const io::LoadedVolume& volume, const std::string& path, Extraction& extraction);

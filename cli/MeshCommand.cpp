@@ -3,12 +3,65 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ChunkedSource.h"
 #include "Commands.h"
 #include "Extraction.h"
 #include "OutputFile.h"
 #include "Report.h"
 
 namespace surftrack::cli {
+
+namespace {
+
+/// A source whose voxels are another's and whose geometry is `geometry`: --frame, --spacing and
+/// --origin on a chunked store read lazily (its layout's geometry is the store's).
+class WithGeometry final : public VoxelSource {
+ public:
+  WithGeometry(std::unique_ptr<VoxelSource> source, const ImageGeometry& geometry)
+      : source_(std::move(source)), geometry_(geometry) {}
+  Dims dims() const override { return source_->dims(); }
+  ImageGeometry geometry() const override { return geometry_; }
+  ScalarType type() const override { return source_->type(); }
+  void binaryBlock(const Selection& s, Voxel origin, int width, int ny, int nz, std::uint16_t* out) const override {
+    source_->binaryBlock(s, origin, width, ny, nz, out);
+  }
+  std::uint64_t binaryRow(const Selection& s, Voxel start, int count) const override {
+    return source_->binaryRow(s, start, count);
+  }
+  void values(const Voxel* voxels, std::size_t n, double* out) const override { source_->values(voxels, n, out); }
+
+ private:
+  std::unique_ptr<VoxelSource> source_;
+  ImageGeometry geometry_;
+};
+
+/// A seeded extraction with --iso or --label from a chunked store, read lazily: only the chunks
+/// the surface crosses are decoded, through a cache of --cache MiB (docs/cli.md, "Input formats").
+void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progress& progress, int stages) {
+  const io::ChunkedStore store = io::openChunkedStore(o.input.path, chunkedStoreOptions(o.input));
+  const auto cache = std::make_shared<const ChunkCache>(store.provider, std::size_t(o.cacheMiB) << 20);
+  const ChunkLayout& layout = cache->layout();
+  ImageGeometry geometry = layout.geometry;
+  x.frame = applyGeometryOptions(o.input, geometry, x.frame);
+  const WithGeometry source(makeChunkedSource(cache), geometry);
+  clock.lap(x.timings, "read");
+  x.input = o.input.path;
+  x.dims = layout.dims;
+  x.type = layout.type;
+  x.geometry = geometry;
+  const std::string choice = store.choiceText();
+  x.storage = "chunked " + store.format + " (" + store.compressor + (choice.empty() ? "" : ", " + choice) +
+              "), read lazily";
+  const Dims counts = layout.chunkCounts();
+  x.chunkCount = std::uint64_t(counts.nx) * std::uint64_t(counts.ny) * std::uint64_t(counts.nz);
+  x.voxelBytes = layout.dims.count() * sizeOf(layout.type);
+  extractSurface(source, nullptr, o.surface, x, clock, progress, 1, stages);
+  x.chunks = cache->counters();
+  x.voxelBytesRead = std::min<std::uintmax_t>(
+      x.chunks->chunksDecoded * std::uint64_t(layout.chunk.count()) * sizeOf(layout.type), x.voxelBytes);
+}
+
+}  // namespace
 
 int runMesh(const std::vector<std::string>& args) {
   const MeshOptions o = parseMeshOptions(args);
@@ -23,15 +76,19 @@ int runMesh(const std::vector<std::string>& args) {
   StageClock clock;
   const int stages = extractionStages(o.surface) + 2;  // + read, write
   progress.stage(0, stages, "reading " + o.input.path);
-  const io::LoadedVolume volume = readInput(o.input);
-  clock.lap(x.timings, "read");
-  describeInput(volume, o.input.path, x);
-
   // A seeded extraction reads bricks near one surface; Otsu's default and the scans read all.
   const bool seeded = o.surface.seedMode != SeedMode::Largest && o.surface.seedMode != SeedMode::All;
-  if (seeded && (o.surface.iso || o.surface.label)) volume.advise(io::LoadedVolume::Access::Sparse);
-  extractSurface(volume.view, o.surface, x, clock, progress, 1, stages);
-  if (volume.mapped) x.voxelBytesResident = volume.residentBytes();
+  const bool sparse = seeded && (o.surface.iso || o.surface.label);
+  if (sparse && isChunkedInput(o.input)) {
+    extractLazily(o, x, clock, progress, stages);
+  } else {
+    const io::LoadedVolume volume = readInput(o.input);
+    clock.lap(x.timings, "read");
+    describeInput(volume, o.input.path, x);
+    if (sparse) volume.advise(io::LoadedVolume::Access::Sparse);
+    extractSurface(volume.view, o.surface, x, clock, progress, 1, stages);
+    if (volume.mapped) x.voxelBytesResident = volume.residentBytes();
+  }
 
   progress.stage(stages - 1, stages, "writing " + o.output);
   x.bytes = writeMeshFile(x.surface, o.output, x.binary);

@@ -442,6 +442,11 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
                  ".ply (binary unless --ascii), .obj, .off, .stl; vertices in physical\ncoordinates")
       ->option_text("OUTPUT")
       ->group("input and output");
+  app.add_option("--cache", o.cacheMiB, "a chunked store read lazily (a seed rule with --iso or --label):\n"
+                 "the decoded chunks kept in memory, in MiB (default 512)")
+      ->option_text("MIB")
+      ->check(CLI::Range(1, 1 << 20))
+      ->group("input and output");
 
   addValue(
       app, "--iso", "S", [&o](const std::string& s) { o.surface.iso = toNumber(s); },

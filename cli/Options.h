@@ -76,6 +76,7 @@ struct MeshOptions {
   SurfaceOptions surface;
   std::string output;   ///< -o: .ply, .obj, .off or .stl
   bool ascii = false;   ///< --ascii: text PLY / STL
+  int cacheMiB = 512;   ///< --cache: decoded chunks kept when a chunked store is read lazily
   OutputOptions out;
 };
 

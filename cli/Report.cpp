@@ -191,6 +191,9 @@ void printSummary(std::ostream& out, const Extraction& x) {
     s << "; voxels read " << bytesText(x.voxelBytesRead) << " of " << bytesText(x.voxelBytes) << " ("
       << num(100.0 * double(x.voxelBytesRead) / double(x.voxelBytes), 3) << " %)";
     if (x.voxelBytesResident) s << ", " << bytesText(*x.voxelBytesResident) << " of it in memory";
+    if (x.chunks)
+      s << "; chunks decoded " << x.chunks->chunksDecoded << " of " << x.chunkCount << " ("
+        << bytesText(x.chunks->bytesRead) << " read from storage, " << x.chunks->hits << " cache hits)";
     row(out, "input", s.str());
   }
   {
@@ -287,6 +290,12 @@ json extractionJson(const Extraction& x) {
     storage["voxel_bytes"] = x.voxelBytes;
     storage["voxel_bytes_read"] = x.voxelBytesRead;
     if (x.voxelBytesResident) storage["voxel_bytes_resident"] = *x.voxelBytesResident;
+    if (x.chunks) {
+      storage["chunks"] = x.chunkCount;
+      storage["chunks_decoded"] = x.chunks->chunksDecoded;
+      storage["chunk_bytes_read"] = x.chunks->bytesRead;
+      storage["chunk_cache_hits"] = x.chunks->hits;
+    }
     j["input_storage"] = std::move(storage);
   }
   if (x.dataRange) j["data_range"] = {number((*x.dataRange)[0]), number((*x.dataRange)[1])};

@@ -595,6 +595,50 @@ def test_cli_meshes_a_store_as_the_same_voxels_in_a_raw_file(tmp_path):
         assert r.returncode == 1 and r.stderr.count("\n") == 1 and says in r.stderr, r.stderr
 
 
+def test_cli_seeded_mesh_reads_a_store_lazily(tmp_path):
+    """`surftrack mesh STORE --iso S --seed ...` decodes only the chunks around the surface (the
+    chunk cache, core/include/surftrack/ChunkedSource.h), with the same PLY bytes as the same
+    voxels in a raw file; --largest reads the store whole, as before, with the same bytes; a
+    one-chunk cache (--cache 1) gives them too."""
+    n = 160
+    z, y, x = np.ogrid[:n, :n, :n]
+    ball = np.where((x - 80.5) ** 2 + (y - 70.2) ** 2 + (z - 90.7) ** 2 < 20 ** 2, 200, 10).astype("<u2")
+    store = tmp_path / "ball.zarr"
+    zarr.open(str(store), mode="w", shape=ball.shape, chunks=(16, 16, 16), dtype="<u2",
+              compressor=numcodecs.Blosc("zstd", 3, numcodecs.Blosc.SHUFFLE))[:] = ball
+    ball.tofile(tmp_path / "ball.raw")
+    inside = ball > 100
+    outside_neighbour = np.zeros_like(inside)
+    for axis in range(3):
+        for step in (1, -1):
+            outside_neighbour |= ~np.roll(inside, step, axis=axis)
+    surface_chunks = len(np.unique(np.argwhere(inside & outside_neighbour) // 16, axis=0))
+    box = np.argwhere(inside)
+    lo, hi = (box.min(axis=0) - 9) // 16, (box.max(axis=0) + 9) // 16
+    near_chunks = int(np.prod(hi - lo + 1))
+    assert near_chunks < 150
+    raw = surftrack("mesh", tmp_path / "ball.raw", "--raw-dims", f"{n},{n},{n}", "--raw-type", "uint16",
+                    "--spacing", "0.5,1,2", "--iso", 100, "--seed", "80,70,90", "-o", tmp_path / "raw.ply")
+    assert raw.returncode == 0, raw.stderr
+    for extra in [(), ("--cache", 1)]:
+        r = surftrack("mesh", store, "--spacing", "0.5,1,2", "--iso", 100, "--seed", "80,70,90",
+                      "-o", tmp_path / "lazy.ply", "--json", *extra)
+        assert r.returncode == 0, r.stderr
+        storage = json.loads(r.stdout)["input_storage"]
+        assert storage["storage"].endswith("read lazily") and storage["chunks"] == 1000
+        # At least every chunk holding a voxel of the surface, at most those within one tracker
+        # brick and its apron (9 voxels) of the ball's box: about a tenth of the 1,000.
+        assert surface_chunks <= storage["chunks_decoded"] <= (near_chunks if not extra else 1000), storage
+        assert (tmp_path / "lazy.ply").read_bytes() == (tmp_path / "raw.ply").read_bytes()
+    whole = surftrack("mesh", store, "--spacing", "0.5,1,2", "--iso", 100, "--largest", "-o", tmp_path / "whole.ply",
+                      "--json")
+    assert whole.returncode == 0, whole.stderr
+    assert "chunks_decoded" not in json.loads(whole.stdout)["input_storage"]
+    assert (tmp_path / "whole.ply").read_bytes() == (tmp_path / "raw.ply").read_bytes()
+    far = surftrack("mesh", store, "--iso", 100, "--seed", "2,2,2", "--max-seed-distance", 4, "-o", tmp_path / "x.ply")
+    assert far.returncode == 1 and far.stderr.count("\n") == 1, far.stderr
+
+
 MUTANTS = [None, 0, -1, 1, 3, 2 ** 31, 2 ** 63, -2 ** 63, 2 ** 64 - 1, 1.5, 1e300, "NaN", "", "x", [], [1], [0, 0, 0],
            [2 ** 40, 1, 1], {}, {"id": "blosc"}, {"type": "gzip"}, True, "<u2", "|u1", ">f8", "F", "/", [[1]], "0.4",
            {"type": "scale", "scale": [1, 1, 1]}]
