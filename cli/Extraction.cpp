@@ -1,6 +1,7 @@
 #include "Extraction.h"
 
 #include <cmath>
+#include <unistd.h>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -89,6 +90,29 @@ std::string applyGeometryOptions(const InputOptions& input, ImageGeometry& g, co
   return out;
 }
 
+namespace {
+
+/// A chunked store is decoded whole only when its voxels take at most half the machine's
+/// memory: beyond, the message names what reads it in parts instead.
+void requireLoadable(const io::ChunkedStore& store, const std::string& path) {
+  const ChunkLayout& layout = store.provider->layout();
+  const double bytes = double(layout.dims.count()) * double(sizeOf(layout.type));
+  const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
+  auto gib = [](double b) {
+    std::ostringstream s;
+    s.precision(3);
+    s << b / double(1 << 30);
+    return s.str();
+  };
+  if (memory > 0 && bytes > memory / 2)
+    throw io::ReadError("cannot read '" + path + "' whole: its voxels take " + gib(bytes) +
+                        " GiB, more than half of this machine's " + gib(memory) +
+                        " GiB; `mesh` with a seed rule and --iso or --label reads only the chunks its surface "
+                        "crosses, and surftrack.distributed meshes every label by blocks");
+}
+
+}  // namespace
+
 io::LoadedVolume readInput(const InputOptions& input) {
   io::ReadOptions options;
   options.channel = input.channel;
@@ -96,7 +120,9 @@ io::LoadedVolume readInput(const InputOptions& input) {
   if (isChunkedInput(input)) {
     // Every chunk decoded into one buffer (docs/cli.md, "Input formats"); a seeded `mesh` reads
     // a store lazily instead (MeshCommand.cpp).
-    volume = io::loadChunkedStore(io::openChunkedStore(input.path, chunkedStoreOptions(input)));
+    const io::ChunkedStore store = io::openChunkedStore(input.path, chunkedStoreOptions(input));
+    requireLoadable(store, input.path);
+    volume = io::loadChunkedStore(store);
   } else {
     volume = input.raw ? io::loadRawVolume(input.path, input.rawLayout) : io::loadVolume(input.path, options);
   }

@@ -635,8 +635,37 @@ def test_cli_seeded_mesh_reads_a_store_lazily(tmp_path):
     assert whole.returncode == 0, whole.stderr
     assert "chunks_decoded" not in json.loads(whole.stdout)["input_storage"]
     assert (tmp_path / "whole.ply").read_bytes() == (tmp_path / "raw.ply").read_bytes()
+    # Every chunk farther than a brick from the ball made garbage: the lazy extraction never
+    # reads one (same bytes), the whole read stops at the first.
+    for name in os.listdir(store):
+        if name.startswith("."):
+            continue
+        index = np.array([int(v) for v in name.split(".")])
+        if np.any(index < lo) or np.any(index > hi):
+            (store / name).write_bytes(b"not a blosc chunk")
+    r = surftrack("mesh", store, "--spacing", "0.5,1,2", "--iso", 100, "--seed", "80,70,90", "-o", tmp_path / "lazy.ply")
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "lazy.ply").read_bytes() == (tmp_path / "raw.ply").read_bytes()
+    r = surftrack("mesh", store, "--iso", 100, "--largest", "-o", tmp_path / "whole.ply")
+    assert r.returncode == 1 and r.stderr.count("\n") == 1 and "chunk" in r.stderr, r.stderr
     far = surftrack("mesh", store, "--iso", 100, "--seed", "2,2,2", "--max-seed-distance", 4, "-o", tmp_path / "x.ply")
     assert far.returncode == 1 and far.stderr.count("\n") == 1, far.stderr
+
+
+def test_a_store_larger_than_memory_is_read_lazily_or_refused(tmp_path):
+    """A 4000^3 uint8 store (60 GiB of voxels, one chunk written): a seeded mesh decodes one
+    chunk; --largest, which would decode it whole, is refused naming what reads it in parts."""
+    store = tmp_path / "huge.zarr"
+    z = zarr.open(str(store), mode="w", shape=(4000, 4000, 4000), chunks=(64, 64, 64), dtype="|u1")
+    z[100:110, 100:110, 100:110] = 5
+    r = surftrack("mesh", store, "--iso", 1, "--seed", "105,105,105", "-o", tmp_path / "a.ply", "--json")
+    assert r.returncode == 0, r.stderr
+    storage = json.loads(r.stdout)["input_storage"]
+    assert storage["chunks_decoded"] == 1 and storage["chunks"] == 63 ** 3
+    r = surftrack("mesh", store, "--iso", 1, "--largest", "-o", tmp_path / "b.ply")
+    assert r.returncode == 1 and r.stderr.count("\n") == 1, r.stderr
+    assert "whole" in r.stderr and "seed rule" in r.stderr and "surftrack.distributed" in r.stderr
+    assert not (tmp_path / "b.ply").exists()
 
 
 MUTANTS = [None, 0, -1, 1, 3, 2 ** 31, 2 ** 63, -2 ** 63, 2 ** 64 - 1, 1.5, 1e300, "NaN", "", "x", [], [1], [0, 0, 0],
