@@ -21,6 +21,9 @@
 #include <surftrack/Labels.h>
 #include <surftrack/Refine.h>
 
+#include "ChunkedSource.h"
+#include "ChunkedStore.h"  // io/: zarr, OME-Zarr, N5
+#include "ReadVolume.h"    // io/: ReadError
 #include "PrecomputedMesh.h"  // converter/: Neuroglancer's format
 
 namespace py = pybind11;
@@ -274,15 +277,16 @@ py::dict surfaceDict(const std::shared_ptr<Result>& r) {
   return out;
 }
 
-/// Runs extract() on `volume` whose engine axes x, y, z are the array axes order[0..2].
-py::dict extractArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
-                      py::object value, const std::string& seedKind, std::array<double, 6> seed,
-                      const std::string& adjacency, const std::string& mapping, double epsilon,
-                      std::array<double, 3> spacing, std::array<double, 3> origin,
-                      std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
-                      py::object progress, int smoothIterations, std::optional<double> maxError,
-                      std::optional<double> reduction, double maxSeedDistance) {
-  const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
+/// Engine x is the last array axis (a zarr array's order, as numpy's C order).
+constexpr std::array<int, 3> kLastAxisFirst = {2, 1, 0};
+
+/// Runs `run` (extract() on a view or a source whose engine axes x, y, z are the array axes
+/// order[0..2]) with the options of Python's extract(), then the refinement.
+py::dict extractWith(const std::function<Surface(const ExtractOptions&)>& run, std::array<int, 3> order,
+                     const std::string& selectionKind, py::object value, const std::string& seedKind,
+                     std::array<double, 6> seed, const std::string& adjacency, const std::string& mapping,
+                     double epsilon, int threads, bool figures, py::object progress, int smoothIterations,
+                     std::optional<double> maxError, std::optional<double> reduction, double maxSeedDistance) {
   ExtractOptions o;
   o.selection = selectionKind == "label" ? Selection::label(labelOf(value, "label"))
                                          : Selection::threshold(value.cast<double>());
@@ -340,7 +344,7 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
   }
   RefineReport refined;
   runEngine(order, cancel, [&] {
-    r->surface = extract(view, o);
+    r->surface = run(o);
     refined = refineSurface(r->surface, ro);
   });
   py::dict out = surfaceDict(r);
@@ -373,6 +377,100 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
     summary["volume_after"] = refined.volumeAfter;
     out["refine"] = summary;
   }
+  return out;
+}
+
+/// Runs extract() on `volume` whose engine axes x, y, z are the array axes order[0..2].
+py::dict extractArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
+                      py::object value, const std::string& seedKind, std::array<double, 6> seed,
+                      const std::string& adjacency, const std::string& mapping, double epsilon,
+                      std::array<double, 3> spacing, std::array<double, 3> origin,
+                      std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
+                      py::object progress, int smoothIterations, std::optional<double> maxError,
+                      std::optional<double> reduction, double maxSeedDistance) {
+  const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
+  return extractWith([&](const ExtractOptions& o) { return extract(view, o); }, order, selectionKind, value,
+                     seedKind, seed, adjacency, mapping, epsilon, threads, figures, progress, smoothIterations,
+                     maxError, reduction, maxSeedDistance);
+}
+
+/// A source whose voxels are another's and whose geometry is given (a store's geometry
+/// replaced by the caller's spacing, origin, direction).
+class SourceWithGeometry final : public VoxelSource {
+ public:
+  SourceWithGeometry(const VoxelSource& source, const ImageGeometry& geometry) : source_(source), geometry_(geometry) {}
+  Dims dims() const override { return source_.dims(); }
+  ImageGeometry geometry() const override { return geometry_; }
+  ScalarType type() const override { return source_.type(); }
+  void binaryBlock(const Selection& s, Voxel origin, int width, int ny, int nz, std::uint16_t* out) const override {
+    source_.binaryBlock(s, origin, width, ny, nz, out);
+  }
+  std::uint64_t binaryRow(const Selection& s, Voxel start, int count) const override {
+    return source_.binaryRow(s, start, count);
+  }
+  void values(const Voxel* voxels, std::size_t n, double* out) const override { source_.values(voxels, n, out); }
+
+ private:
+  const VoxelSource& source_;
+  ImageGeometry geometry_;
+};
+
+/// extract() from the chunked store at `path` (zarr, OME-Zarr, N5: io/ChunkedStore.h), read
+/// lazily through a cache of `cacheBytes` (ChunkedSource.h); engine x is the array's last axis.
+/// `spacing`, `origin`, `direction` (array axes) replace the store's geometry when given. The
+/// dict has the surface's fields and "chunks" (chunks in the store, decoded, bytes read, hits).
+py::dict extractStore(const std::string& path, int level, std::optional<std::int64_t> channel,
+                      std::optional<std::int64_t> time, std::size_t cacheBytes, const std::string& selectionKind,
+                      py::object value, const std::string& seedKind, std::array<double, 6> seed,
+                      const std::string& adjacency, const std::string& mapping, double epsilon,
+                      std::optional<std::array<double, 3>> spacing, std::optional<std::array<double, 3>> origin,
+                      std::optional<std::array<std::array<double, 3>, 3>> direction, int threads, bool figures,
+                      py::object progress, int smoothIterations, std::optional<double> maxError,
+                      std::optional<double> reduction, double maxSeedDistance) {
+  io::ChunkedStoreOptions chosen;
+  chosen.level = level;
+  chosen.channel = channel;
+  chosen.time = time;
+  io::ChunkedStore store;
+  try {
+    store = io::openChunkedStore(path, chosen);
+  } catch (const io::ReadError& e) {
+    throw py::value_error(e.what());
+  }
+  const auto cache = std::make_shared<const ChunkCache>(store.provider, cacheBytes);
+  const std::unique_ptr<VoxelSource> chunked = makeChunkedSource(cache);
+  // Python's coordinates follow the array's axes (z, y, x for a store): the store's physical
+  // rows (x, y, z) reversed.
+  const ImageGeometry stored = chunked->geometry();
+  ImageGeometry g = stored;
+  for (int k = 0; k < 3; ++k) {
+    g.origin[k] = stored.origin[2 - k];
+    for (int e = 0; e < 3; ++e) g.direction[k][e] = stored.direction[2 - k][e];
+  }
+  for (int e = 0; e < 3; ++e) {  // engine axis e is array axis 2 - e
+    const int a = kLastAxisFirst[e];
+    if (spacing) g.spacing[e] = (*spacing)[a];
+    if (direction)
+      for (int k = 0; k < 3; ++k) g.direction[k][e] = (*direction)[k][a];
+  }
+  if (origin) g.origin = *origin;
+  const SourceWithGeometry source(*chunked, g);
+  py::dict out;
+  try {
+    out = extractWith([&](const ExtractOptions& o) { return extract(source, o); }, kLastAxisFirst, selectionKind,
+                      value, seedKind, seed, adjacency, mapping, epsilon, threads, figures, progress,
+                      smoothIterations, maxError, reduction, maxSeedDistance);
+  } catch (const io::ReadError& e) {
+    throw py::value_error(e.what());  // a chunk that cannot be decoded
+  }
+  const ChunkCacheCounters c = cache->counters();
+  const Dims n = cache->layout().chunkCounts();
+  py::dict chunks;
+  chunks["chunks"] = std::uint64_t(n.nx) * std::uint64_t(n.ny) * std::uint64_t(n.nz);
+  chunks["decoded"] = c.chunksDecoded;
+  chunks["bytes_read"] = c.bytesRead;
+  chunks["hits"] = c.hits;
+  out["chunks"] = chunks;
   return out;
 }
 
@@ -421,7 +519,6 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
 /// Array axes (z, y, x) as the engine's voxel (x, y, z): engine x is the last array axis, as
 /// the block functions below read the array (order {2, 1, 0}).
 Voxel engineVoxel(const std::array<int, 3>& zyx) { return Voxel{zyx[2], zyx[1], zyx[0]}; }
-constexpr std::array<int, 3> kLastAxisFirst = {2, 1, 0};
 
 /// scanLabelBlock (docs/theory.md, "Label maps by blocks") on `box`, the voxels [origin,
 /// origin + box.shape) of a volume of shape `volume`, owning the cubes of [lo, hi) (all in array
@@ -586,6 +683,7 @@ PYBIND11_MODULE(_surftrack, m) {
       .def("normals", &Result::normals)
       .def("surfels", &Result::surfels);
   m.def("extract_array", &extractArray);
+  m.def("extract_store", &extractStore);
   m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
   m.def("write_precomputed", &writePrecomputed);

@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import Callable, Optional, Sequence
 
 import os as _os
+import os
 import warnings as _warnings
 
 import numpy as np
@@ -113,6 +114,21 @@ class Surface:
         _surftrack.write_arrays(self.vertices, self.faces, self.surfels, str(path), binary)
 
 
+def _store_path(volume) -> Optional[str]:
+    """The directory of a chunked store the engine reads itself: a path to one, or a zarr array
+    on a directory store; None for anything else (read as an array)."""
+    if isinstance(volume, (str, os.PathLike)):
+        path = os.fspath(volume)
+        if not os.path.isdir(path):
+            raise ValueError(f"'{path}' is not a directory: a chunked store (zarr, OME-Zarr, N5) is one")
+        return path
+    store = getattr(volume, "store", None)
+    root = getattr(store, "path", None)
+    if root is not None and hasattr(volume, "chunks") and isinstance(root, str) and os.path.isdir(root):
+        return os.path.join(root, getattr(volume, "path", "") or "")
+    return None
+
+
 def _as_volume(volume) -> np.ndarray:
     """The volume as an array the engine reads in place; checked before any voxel is read (a
     broadcast array can have a vast shape over a single value)."""
@@ -201,7 +217,9 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
             epsilon: float = 1e-3, threads: int = 0, figures: bool = True,
             progress: Optional[Callable[[str, int, int, int], None]] = None,
             smooth: int = 0, max_error: Optional[float] = None,
-            reduce: Optional[float] = None, max_seed_distance: float = 256.0) -> Surface:
+            reduce: Optional[float] = None, max_seed_distance: float = 256.0,
+            store_level: int = 0, store_channel: Optional[int] = None, store_time: Optional[int] = None,
+            cache_mib: int = 512) -> Surface:
     """The surface of one boundary (mode="seed"), of the largest, or of all boundaries.
 
     The selected voxels are ``volume > level`` or ``volume == label``. ``seed`` is a voxel index
@@ -222,9 +240,27 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
     with N Taubin iterations (at most 100000, as the CLI), every vertex kept on its surfel's
     segment (the same voxels inside, the same topology); ``max_error`` (physical units) and/or ``reduce`` (the fraction
     of triangles to remove) then decimate without changing the topology (docs/python.md).
+    ``volume`` may also be a chunked store — a zarr array on local or network files
+    (``zarr.open(path)``), or the path of a zarr array, OME-Zarr image or N5 dataset: read lazily,
+    only the chunks near the surface decoded (``store_level``, ``store_channel``, ``store_time``
+    choose in it, ``cache_mib`` bounds the decoded chunks kept; ``surface.chunks`` says how many
+    were decoded); its spacing and origin are the store's unless given. Only ``mode="seed"`` with
+    ``level`` or ``label`` (docs/python.md, "Chunked stores").
     Raises ValueError / TypeError on bad input; Ctrl-C stops any stage (KeyboardInterrupt).
     """
-    array = _as_volume(volume)
+    store = _store_path(volume)
+    if store is not None:
+        # A chunked store is read lazily, chunk by chunk, by the engine's own readers: only a
+        # seeded extraction with a level or a label, which reads near its surface.
+        if mode != "seed":
+            raise ValueError(f"mode='{mode}' reads every voxel of the store: read it whole "
+                             "(np.asarray) or mesh it by blocks (surftrack.distributed)")
+        if level is None and label is None:
+            raise ValueError("a chunked store needs level= or label=: the default level, the middle "
+                             "of the data range, would read every chunk")
+        array = None
+    else:
+        array = _as_volume(volume)
     if affine is not None:
         spacing, origin, direction = _split_affine(affine)
     if (level is None) == (label is None):
@@ -279,12 +315,27 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
     # the same surface. C order reads whole rows at a time (the fast path); other orders read
     # voxel by voxel, in place.
     order = [2, 1, 0]
+    kind, value = ("label", label) if label is not None else ("threshold", float(level))
+    if store is not None:
+        given = lambda v, default: None if tuple(v) == default else list(v)  # noqa: E731
+        out = _surftrack.extract_store(
+            store, int(store_level), store_channel, store_time, int(cache_mib) << 20, kind, value, seed_kind,
+            seed_values, adjacency, mapping, float(epsilon), given(spacing, (1.0, 1.0, 1.0)),
+            given(origin, (0.0, 0.0, 0.0)),
+            None if np.array_equal(direction, np.eye(3)) else direction.tolist(), int(threads), bool(figures),
+            progress, int(smooth), None if max_error is None else float(max_error),
+            None if reduce is None else float(reduce), float(max_seed_distance))
+        chunks = out.pop("chunks")
+        surface = Surface(**out)
+        surface.chunks = chunks
+        for message in surface.warnings:
+            _warnings.warn(message, stacklevel=2)
+        return surface
     if seed_kind in ("largest", "all") and not array.flags.c_contiguous:
         # The scan reads every voxel row by row: one C-ordered copy is faster than reading
         # across memory, and it is read once anyway (a seeded extraction never copies).
         array = np.ascontiguousarray(array)
     # A label goes to the engine as it is (an int stays exact beyond 2^53); a level as a float.
-    kind, value = ("label", label) if label is not None else ("threshold", float(level))
     try:
         out = _surftrack.extract_array(array, order, kind, value, seed_kind, seed_values,
                                        adjacency, mapping, float(epsilon), spacing, origin,
