@@ -37,11 +37,11 @@ struct Volume {
 /// interior and cavities) or noise, often cut by the faces; floats with now and then NaN,
 /// infinities and values exactly at the level.
 template <class T>
-Volume<T> randomVolume(std::mt19937_64& rng, double level) {
+Volume<T> randomVolume(std::mt19937_64& rng, double level, bool wide) {
   auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
   std::uniform_real_distribution<double> real(0.0, 1.0);
   Volume<T> v;
-  v.dims = {uniform(3, 12), uniform(2, 10), uniform(3, 9)};
+  v.dims = wide ? Dims{uniform(60, 140), uniform(2, 4), uniform(2, 4)} : Dims{uniform(3, 12), uniform(2, 10), uniform(3, 9)};
   v.f.resize(v.dims.count());
   const int bumps = uniform(0, 5);
   std::vector<std::array<double, 5>> b;
@@ -165,14 +165,16 @@ struct Tally {
   int cases = 0, empty = 0, blocks = 0, thin = 0, single = 0, nonFinite = 0;
 };
 
+/// `iterations` random volumes of voxel type T (`wide`: rows of 60 to 140 voxels, across the
+/// 64-voxel words by which the single pass numbers a row's edges) through both mappings.
 template <class T>
-void checkVolumes(AdjacencyPair pair, std::uint64_t seed, int iterations, Tally& tally) {
+void checkVolumes(AdjacencyPair pair, std::uint64_t seed, int iterations, Tally& tally, bool wide = false) {
   std::mt19937_64 rng(seed);
   auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
   for (int iteration = 0; iteration < iterations; ++iteration) {
     const double level = std::is_integral_v<T> ? uniform(40, 120) + (uniform(0, 1) ? 0.5 : 0.0)
                                                : 60 + uniform(-400, 400) * 0.1;
-    Volume<T> v = randomVolume<T>(rng, level);
+    Volume<T> v = randomVolume<T>(rng, level, wide);
     ImageGeometry geometry;
     geometry.spacing = {0.5 + uniform(0, 8) * 0.25, 1.0 + uniform(0, 4) * 0.1, 0.3 + uniform(0, 6) * 0.7};
     geometry.origin = {uniform(-50, 50) * 0.37, uniform(-50, 50) * 1.3, uniform(-50, 50) * 0.11};
@@ -257,6 +259,16 @@ TEST_P(ThresholdBlocks, MergedFragmentsAreTheSinglePass) {
               "uint8: %d cases (%d empty), %d blocks (%d thin), %d single-block\n",
               f32.cases, f32.empty, f32.blocks, f32.thin, f32.single, f32.nonFinite, u8.cases, u8.empty, u8.blocks,
               u8.thin, u8.single);
+}
+
+/// Rows wider than a word of the single pass's row bit sets, and other voxel types.
+TEST_P(ThresholdBlocks, WideRowsAndOtherTypes) {
+  const AdjacencyPair pair = GetParam();
+  Tally f64, i16, u8;
+  checkVolumes<double>(pair, 0x9B10C5 + std::uint64_t(pair), 20, f64, true);
+  checkVolumes<std::int16_t>(pair, 0xAB10C5 + std::uint64_t(pair), 20, i16, true);
+  checkVolumes<std::uint8_t>(pair, 0xBB10C5 + std::uint64_t(pair), 20, u8, true);
+  for (const Tally* t : {&f64, &i16, &u8}) EXPECT_GE(t->cases, int(ref::subsetMinimum(15)));
 }
 
 INSTANTIATE_TEST_SUITE_P(Pairs, ThresholdBlocks, ::testing::ValuesIn(kAllAdjacencyPairs), ref::pairTestName);
