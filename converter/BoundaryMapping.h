@@ -24,6 +24,17 @@ inline std::array<double, 3> pointOnSurfel(const Surfel& s, double t) {
   return {c.x + t * (d.x - c.x), c.y + t * (d.y - c.y), c.z + t * (d.z - c.z)};
 }
 
+/// The interpolation parameter of the iso-value mapping (below) from the gray values f(c), f(d)
+/// of a surfel's voxels: (s - f(c)) / (f(d) - f(c)) clamped into [epsilon, 1 - epsilon], or
+/// 0.5 where it is undefined (f(c) = f(d), a NaN). One expression for every caller, so that a
+/// vertex placed from a block's fragment is bit-equal to the single pass's (docs/theory.md,
+/// "Thresholds by blocks").
+inline double linearParameter(double isoValue, double fc, double fd, double epsilon) {
+  const double t = (isoValue - fc) / (fd - fc);
+  if (!std::isfinite(t)) return 0.5;
+  return std::clamp(t, epsilon, 1.0 - epsilon);
+}
+
 /// The trivial boundary mapping g(c, d) = (c + d) / 2 (§3.1).
 struct MidpointMapping {
   std::array<double, 3> operator()(const Surfel& s) const { return pointOnSurfel(s, 0.5); }
@@ -57,10 +68,7 @@ class IsoValueMapping {
     const Voxel c = s.inside(), d = s.outside();
     const Dims& dims = gray_.dims;
     if (!dims.contains(c) || !dims.contains(d)) return 0.5;
-    const double fc = double(gray_.at(c)), fd = double(gray_.at(d));
-    const double t = (iso_ - fc) / (fd - fc);
-    if (!std::isfinite(t)) return 0.5;
-    return std::clamp(t, epsilon_, 1.0 - epsilon_);
+    return linearParameter(iso_, double(gray_.at(c)), double(gray_.at(d)), epsilon_);
   }
 
   std::array<double, 3> operator()(const Surfel& s) const { return pointOnSurfel(s, parameter(s)); }

@@ -11,6 +11,8 @@
 // The cube with min corner (x, y, z) has its corners in rows j, j + 1 of planes z, z + 1, bits
 // b, b + 1. Its 12 edges (DigitalCube.h) lie in the two planes (x- and y-edges) or between
 // them (z-edges); each cut edge gets its vertex index before the first cube around it is visited.
+// The vertex order this gives (a function of the edge alone) is reproduced by the merge of a
+// threshold's block fragments (core/src/ThresholdBlocks.cpp, scanOrder): change both together.
 #include "ScanIsoSurface.h"
 
 #include "MeshComponents.h"

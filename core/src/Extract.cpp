@@ -188,10 +188,8 @@ static void placeVertices(const VoxelSource& source, const std::vector<Surfel>& 
     const Surfel& s = surfels[v];
     double t = 0.5;  // a voxel outside the domain: no gray value to interpolate
     if (dims.contains(s.inside()) && dims.contains(s.outside())) {
-      const double fc = f[next], fd = f[next + 1];
+      t = linearParameter(selection.value, f[next], f[next + 1], epsilon);
       next += 2;
-      const double u = (selection.value - fc) / (fd - fc);
-      if (std::isfinite(u)) t = std::clamp(u, epsilon, 1.0 - epsilon);
     }
     points[v] = pointOnSurfel(s, t);
   }

@@ -15,6 +15,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "BlockOwnership.h"
 #include "BoundaryMapping.h"
 #include "Image.h"
 #include "LabelSelection.h"
@@ -25,35 +26,6 @@
 
 namespace surftrack {
 namespace {
-
-std::string boxText(Voxel lo, Voxel hi) {
-  std::ostringstream s;
-  s << "[" << lo.x << "," << hi.x << ")x[" << lo.y << "," << hi.y << ")x[" << lo.z << "," << hi.z << ")";
-  return s.str();
-}
-
-/// The block's core, box and volume fit together (scanLabelBlock's contract), or InvalidInput.
-void requireBlock(const VolumeView& view, Voxel origin, Dims volume, Voxel lo, Voxel hi) {
-  for (int a = 0; a < 3; ++a)
-    if (volume[a] <= 0 || volume[a] >= Surfel::kCoordinateLimit - 2) {
-      std::ostringstream msg;
-      msg << "volume dimensions " << volume.nx << "x" << volume.ny << "x" << volume.nz
-          << " are not supported: each must be in [1, " << Surfel::kCoordinateLimit - 3 << "]";
-      throw InvalidInput(msg.str());
-    }
-  const Voxel end = origin + Voxel{view.dims.nx, view.dims.ny, view.dims.nz};
-  const Voxel size{volume.nx, volume.ny, volume.nz};
-  for (int a = 0; a < 3; ++a) {
-    if (lo[a] < 0 || lo[a] >= hi[a] || hi[a] > volume[a])
-      throw InvalidInput("block core " + boxText(lo, hi) + " is empty or not in the volume " +
-                         boxText({}, size));
-    if (origin[a] < 0 || end[a] > volume[a])
-      throw InvalidInput("block box " + boxText(origin, end) + " is not in the volume " + boxText({}, size));
-    if (origin[a] > lo[a] || end[a] < std::min(hi[a] + 1, volume[a]))
-      throw InvalidInput("block box " + boxText(origin, end) + " does not hold the core " + boxText(lo, hi) +
-                         " and its one-voxel apron on the high sides");
-  }
-}
 
 template <class T>
 std::vector<LabelFragment> scanBlockTyped(const VolumeView& view, Voxel origin, Voxel lo, Voxel hi,
@@ -94,42 +66,13 @@ std::vector<LabelFragment> scanBlockTyped(const VolumeView& view, Voxel origin, 
   if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
   scan.fill(arrays, [](const Surfel&) { return std::array<double, 3>{}; });  // keys only: never placed
 
-  // The scan numbered every surfel of the planes it read; an owned cube's triangles use only
-  // surfels of the volume (both voxels in the box or outside the volume), the others are dropped.
+  // Only the surfels of the owned cubes' triangles (BlockOwnership.h).
   arena.execute([&] {
-    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-      LabelFragment& f = all[i];
-      std::vector<std::uint32_t> index(f.keys.size(), 0);
-      for (const auto& t : f.triangles)
-        for (std::uint32_t v : t) index[v] = 1;
-      std::uint32_t next = 0;
-      for (std::size_t v = 0; v < index.size(); ++v)
-        if (index[v]) {
-          f.keys[next] = f.keys[v];  // next <= v: in place, still increasing
-          index[v] = next++;
-        }
-      f.keys.resize(next);
-      f.keys.shrink_to_fit();
-      for (auto& t : f.triangles)
-        for (std::uint32_t& v : t) v = index[v];
-    });
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { dropUnusedKeys(all[i].keys, all[i].triangles); });
   });
   // Labels met only in the apron with no triangle in the owned cubes belong to other blocks.
   std::erase_if(all, [](const LabelFragment& f) { return f.voxels == 0 && f.triangles.empty(); });
   return all;
-}
-
-/// The min corner of the cube that owns a triangle of these surfels: the componentwise minimum
-/// of their six voxels (no table triangle lies in a cube face, tests/test_configuration_tables.cpp),
-/// packed so that the order of the packed values is the scan's order of the cubes (z, y, x).
-std::uint64_t owningCube(const std::array<std::uint64_t, 3>& keys) {
-  Voxel m{std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max()};
-  for (std::uint64_t key : keys) {
-    const Surfel s = Surfel::fromKey(key);
-    for (const Voxel v : {s.inside(), s.outside()}) m = {std::min(m.x, v.x), std::min(m.y, v.y), std::min(m.z, v.z)};
-  }
-  auto field = [](int v) { return std::uint64_t(v + Surfel::kCoordinateLimit) & 0x1FFFFFu; };
-  return field(m.z) << 42 | field(m.y) << 21 | field(m.x);
 }
 
 }  // namespace
@@ -164,9 +107,8 @@ LabelSurface mergeLabelFragments(const std::vector<LabelFragment>& fragments, co
   for (const LabelFragment& f : fragments) {
     if (f.label != label)
       throw InvalidInput("fragments of labels " + label.text() + " and " + f.label.text() + " in one merge");
-    for (std::size_t v = 0; v < f.keys.size(); ++v)
-      if (f.keys[v] >> 63 || (f.keys[v] & 7) > 5 || (v > 0 && f.keys[v] <= f.keys[v - 1]))
-        throw InvalidInput("a fragment of label " + label.text() + " has keys out of range or not increasing");
+    if (!validKeys(f.keys))
+      throw InvalidInput("a fragment of label " + label.text() + " has keys out of range or not increasing");
     for (const auto& t : f.triangles)
       for (std::uint32_t v : t)
         if (v >= f.keys.size())

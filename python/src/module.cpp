@@ -20,6 +20,7 @@
 #include <surftrack/Extract.h>
 #include <surftrack/Labels.h>
 #include <surftrack/Refine.h>
+#include <surftrack/ThresholdBlocks.h>
 
 #include "ChunkedSource.h"
 #include "ChunkedStore.h"  // io/: zarr, OME-Zarr, N5
@@ -548,11 +549,10 @@ py::list scanLabelBlockArray(py::array box, std::array<int, 3> origin, std::arra
   return out;
 }
 
-/// mergeLabelFragments: the fragments (voxels, keys, triangles) of `label` from every block of a
-/// partition, as label_surfaces_array gives that label (geometry in array axes).
-py::dict mergeLabelFragmentsArrays(py::object label, py::list fragments, std::array<double, 3> spacing,
-                                   std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
-                                   py::object background, const std::string& adjacency, bool figures) {
+/// A geometry given in array axes (spacing per array axis, direction columns per array axis) as
+/// the engine's, whose x, y, z are the array's last, middle, first axes (kLastAxisFirst).
+ImageGeometry geometryOfArrayAxes(const std::array<double, 3>& spacing, const std::array<double, 3>& origin,
+                                  const std::array<std::array<double, 3>, 3>& direction) {
   ImageGeometry geometry;
   for (int e = 0; e < 3; ++e) {
     const int a = kLastAxisFirst[e];
@@ -560,6 +560,15 @@ py::dict mergeLabelFragmentsArrays(py::object label, py::list fragments, std::ar
     for (int k = 0; k < 3; ++k) geometry.direction[k][e] = direction[k][a];
   }
   geometry.origin = origin;
+  return geometry;
+}
+
+/// mergeLabelFragments: the fragments (voxels, keys, triangles) of `label` from every block of a
+/// partition, as label_surfaces_array gives that label (geometry in array axes).
+py::dict mergeLabelFragmentsArrays(py::object label, py::list fragments, std::array<double, 3> spacing,
+                                   std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
+                                   py::object background, const std::string& adjacency, bool figures) {
+  const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
   LabelOptions o;
   o.background = labelOf(background, "background");
   o.pair = parseAdjacencyPair(adjacency);
@@ -591,6 +600,83 @@ py::dict mergeLabelFragmentsArrays(py::object label, py::list fragments, std::ar
   });
   py::dict d = surfaceDict(r);
   d["voxels"] = voxels;
+  return d;
+}
+
+/// The options of a threshold block scan and its merge: every boundary of f > level.
+ExtractOptions thresholdBlockOptions(double level, const std::string& adjacency, const std::string& mapping,
+                                     double epsilon, bool figures) {
+  ExtractOptions o;
+  o.selection = Selection::threshold(level);
+  o.seed = SeedRule::all();
+  o.pair = parseAdjacencyPair(adjacency);
+  o.mapping = parseMapping(mapping);
+  o.epsilon = epsilon;
+  o.figures = figures;
+  return o;
+}
+
+/// scanThresholdBlock (docs/theory.md, "Thresholds by blocks") on `box`, the voxels [origin,
+/// origin + box.shape) of a volume of shape `volume`, owning the cubes of [lo, hi) (all in array
+/// axes): (voxels, keys (K,) uint64, values (K, 2) float64 — f(c), f(d), (0, 2) for the midpoint
+/// mapping —, triangles (M, 3) uint32).
+py::tuple scanThresholdBlockArray(py::array box, std::array<int, 3> origin, std::array<int, 3> volume,
+                                  std::array<int, 3> lo, std::array<int, 3> hi, double level,
+                                  const std::string& adjacency, const std::string& mapping, double epsilon) {
+  const VolumeView view = viewOfArray(box, kLastAxisFirst, {1, 1, 1}, {0, 0, 0}, {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}});
+  ExtractOptions o = thresholdBlockOptions(level, adjacency, mapping, epsilon, false);
+  const Voxel v = engineVoxel(volume);
+  ThresholdFragment f;
+  std::atomic<bool> cancel{false};
+  o.cancel = &cancel;
+  runEngine(kLastAxisFirst, cancel, [&] {
+    f = scanThresholdBlock(view, engineVoxel(origin), Dims{v.x, v.y, v.z}, engineVoxel(lo), engineVoxel(hi), o);
+  });
+  py::array_t<std::uint64_t> keys(py::ssize_t(f.keys.size()));
+  std::copy(f.keys.begin(), f.keys.end(), keys.mutable_data());
+  py::array_t<double> values({py::ssize_t(f.values.size()), py::ssize_t(2)});
+  if (!f.values.empty()) std::memcpy(values.mutable_data(), f.values.data(), f.values.size() * 16);
+  py::array_t<std::uint32_t> triangles({py::ssize_t(f.triangles.size()), py::ssize_t(3)});
+  if (!f.triangles.empty()) std::memcpy(triangles.mutable_data(), f.triangles.data(), f.triangles.size() * 12);
+  return py::make_tuple(f.voxels, keys, values, triangles);
+}
+
+/// mergeThresholdFragments: the fragments (voxels, keys, values, triangles) of every block of a
+/// partition of a volume of shape `volume`, as extract_array gives mode "all" (geometry in array
+/// axes).
+py::dict mergeThresholdFragmentsArrays(py::list fragments, std::array<int, 3> volume, double level,
+                                       std::array<double, 3> spacing, std::array<double, 3> origin,
+                                       std::array<std::array<double, 3>, 3> direction, const std::string& adjacency,
+                                       const std::string& mapping, double epsilon, bool figures) {
+  const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
+  const ExtractOptions o = thresholdBlockOptions(level, adjacency, mapping, epsilon, figures);
+  const Voxel v = engineVoxel(volume);
+  std::vector<ThresholdFragment> parts;
+  for (py::handle h : fragments) {
+    const py::tuple t = h.cast<py::tuple>();
+    if (t.size() != 4) throw py::value_error("a fragment is (voxels, keys (K,), values (K, 2), triangles (M, 3))");
+    const auto keys = t[1].cast<py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>>();
+    const auto values = t[2].cast<py::array_t<double, py::array::c_style | py::array::forcecast>>();
+    const auto triangles = t[3].cast<py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>>();
+    if (keys.ndim() != 1 || values.ndim() != 2 || values.shape(1) != 2 || triangles.ndim() != 2 ||
+        triangles.shape(1) != 3)
+      throw py::value_error("a fragment is (voxels, keys (K,), values (K, 2), triangles (M, 3))");
+    ThresholdFragment f;
+    f.volume = Dims{v.x, v.y, v.z};
+    f.voxels = t[0].cast<std::uint64_t>();
+    f.keys.assign(keys.data(), keys.data() + keys.shape(0));
+    f.values.resize(std::size_t(values.shape(0)));
+    if (!f.values.empty()) std::memcpy(f.values.data(), values.data(), f.values.size() * 16);
+    f.triangles.resize(std::size_t(triangles.shape(0)));
+    if (!f.triangles.empty()) std::memcpy(f.triangles.data(), triangles.data(), f.triangles.size() * 12);
+    parts.push_back(std::move(f));
+  }
+  auto r = std::make_shared<Result>();
+  r->order = kLastAxisFirst;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] { r->surface = mergeThresholdFragments(parts, geometry, o); });
+  py::dict d = surfaceDict(r);
+  d["warnings"] = r->surface.warnings;
   return d;
 }
 
@@ -689,4 +775,6 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("write_precomputed", &writePrecomputed);
   m.def("scan_label_block", &scanLabelBlockArray);
   m.def("merge_label_fragments", &mergeLabelFragmentsArrays);
+  m.def("scan_threshold_block", &scanThresholdBlockArray);
+  m.def("merge_threshold_fragments", &mergeThresholdFragmentsArrays);
 }
