@@ -193,7 +193,8 @@ class Parser {
   /// The files of ElementDataFile = LIST [D], as MetaIO reads them: one name per line after the
   /// header (getline into 1024 bytes), one file for each D-dimensional block (D = NDims - 1 by
   /// default, as MetaIO takes it). A missing, empty or overlong name would make MetaIO read a
-  /// file it cannot open into its buffer, and crash (found by fuzz/). False if the head ends
+  /// file it cannot open into its buffer, and crash (found by fuzz/); a
+  /// name without its newline is skipped. False if the head ends
   /// before the last name and the file is longer; the names go to listed_.
   bool listComplete(std::size_t start, bool whole) {
     const auto w = metaWords();
@@ -214,13 +215,18 @@ class Parser {
     listed_.clear();
     std::size_t pos = start;
     for (std::int64_t i = 0; i < files; ++i) {
-      // (The last name may end the file without its '\n': MetaIO's getline reads it.)
       const text::Line line = text::lineAt(head_, pos);
       if (!line.ended && !whole) return false;
       std::string_view name = line.text;
       if (!name.empty() && name.back() == '\r') name.remove_suffix(1);
       if (pos >= head_.size() || trim(name).empty())
         fail("lists " + std::to_string(i) + " data files, and the image needs " + std::to_string(files));
+      // MetaIO tests for the end of the file after each getline and skips the name that ends
+      // it without its '\n': that file's voxels would be left unread, as whatever the buffer
+      // held (found by the sanitized test suite, whose allocator fills new memory).
+      if (!line.ended)
+        fail("lists " + std::to_string(i) + " data files, and the image needs " + std::to_string(files) +
+             " (MetaIO skips a last name without its newline)");
       if (name.size() >= 1023) fail("lists a data file name of more than 1022 characters");
       for (char c : name)
         if (text::isControl(c)) fail("lists a data file name with a control character");

@@ -399,6 +399,20 @@ void requireCompleteData(itk::ImageIOBase* imageIO, const std::string& path, std
         break;
       }
     }
+    if (dataFile.rfind("LIST", 0) == 0) {
+      // MetaIO leaves the voxels of a blank, missing or unterminated entry of the list unread
+      // (uninitialised): the loader's parser refuses such lists, and readVolume with it.
+      std::error_code ec;
+      const std::uintmax_t size = fs::file_size(path, ec);
+      std::ifstream whole(path, std::ios::binary);
+      std::string head(std::size_t(std::min<std::uintmax_t>(size, kMaxHeaderBytes)), '\0');
+      head.resize(std::size_t(whole.read(head.data(), std::streamsize(head.size())).gcount()));
+      try {
+        parseMetaImageHeader(head, head.size() < size ? size : head.size());
+      } catch (const HeaderError& e) {
+        throw ReadError("cannot read '" + path + "': " + e.what());
+      }
+    }
     if (compressed || dataFile.empty()) return;
     const std::size_t bytes = voxels * imageIO->GetComponentSize();
     std::error_code ec;

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
       triangles.push_back(t);
     }
     const auto topology = surftrack::checks::topologyOf(points.size(), triangles);
-    const std::size_t pairs = surftrack::checks::selfIntersections(surftrack::checks::cgalMesh(points, triangles));
+    const std::size_t pairs = surftrack::checks::selfIntersections(points, triangles);
     std::printf("{\"path\": \"%s\", \"triangles\": %zu, \"closed_oriented\": %s, \"manifold\": %s, \"euler\": %lld, "
                 "\"components\": %zu, \"genus\": %s, \"self_intersecting_pairs\": %zu}\n",
                 argv[i], triangles.size(), topology.closedOriented ? "true" : "false",

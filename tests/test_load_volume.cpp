@@ -547,14 +547,20 @@ TEST(LoadVolume, NumberedAndListedDataFilesAreDecodedByItk) {
   const std::string list = dir / "list.nhdr";
   writeFile(list, nrrdHeader("uint16", kDims, "endian: little\nencoding: raw\ndata file: LIST\n") +
                       "slice1.raw\nslice2.raw\nslice3.raw\n");
-  // A MetaImage list whose last name ends the file without its newline (MetaIO reads it).
   const std::string metaList = dir / "list.mhd";
-  writeFile(metaList, metaHeader("MET_USHORT", kDims, "", "LIST") + "slice1.raw\nslice2.raw\nslice3.raw");
+  writeFile(metaList, metaHeader("MET_USHORT", kDims, "", "LIST") + "slice1.raw\nslice2.raw\nslice3.raw\n");
+  // A MetaImage list whose last name ends the file without its newline: MetaIO skips that name
+  // and leaves its slice unread, so both readers refuse the list.
+  const std::string unended = dir / "unended.mhd";
+  writeFile(unended, metaHeader("MET_USHORT", kDims, "", "LIST") + "slice1.raw\nslice2.raw\nslice3.raw");
+  expectReadError([&] { io::loadVolume(unended); }, {unended, "lists 2 data files", "without its newline"});
+  expectReadError([&] { io::readVolume(unended); }, {unended, "lists 2 data files", "without its newline"});
   // A NRRD list of one file holding all three dimensions, with "\r\n" line ends.
   writeFile(dir / "all.raw", all);
   const std::string wholeList = dir / "list3.nhdr";
   writeFile(wholeList, nrrdHeader("uint16", kDims, "endian: little\nencoding: raw\ndata file: LIST 3\r\n") + "all.raw\r\n");
   for (const std::string& path : {mhd, nhdr, list, metaList, wholeList}) {
+    SCOPED_TRACE(path);
     const LoadedVolume loaded = io::loadVolume(path);
     EXPECT_FALSE(loaded.mapped) << path;
     EXPECT_NE(loaded.decodeReason.find("files"), std::string::npos) << loaded.decodeReason;
@@ -918,8 +924,9 @@ TEST(LoadVolume, CorruptHeadersAreReadErrors) {
       {"shortfile.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\ntiny.raw\nok.raw\n", "truncated"},
       // A list cut short after a name without its newline: the parser read past its buffer
       // (std::out_of_range, found by fuzz/).
-      {"cutlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nok.raw", "lists 2 data files"},
-      {"cutlist1.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ab", "lists 1 data files"},
+      // (MetaIO skips the unterminated name, so the list has one name fewer.)
+      {"cutlist.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ok.raw\nok.raw", "lists 1 data files"},
+      {"cutlist1.mhd", metaHeader("MET_SHORT", kDims, "", "LIST") + "ab", "lists 0 data files"},
       // Three spaces in a row, which MetaIO counts as two words and then reads a word it never
       // wrote (a crash under fuzz/).
       {"spaces.mhd", metaHeader("MET_SHORT", kDims, "", "slice%d.raw   1 3 1"), "three or more spaces"},

@@ -46,7 +46,7 @@ struct Shape {
 Shape shapeOf(const Surface& s) {
   Shape out;
   out.topology = ck::topologyOf(s.vertices.size(), s.triangles);
-  out.selfIntersections = ck::selfIntersections(ck::cgalMesh(s.vertices, s.triangles));
+  out.selfIntersections = ck::selfIntersections(s.vertices, s.triangles);
   return out;
 }
 
@@ -80,16 +80,15 @@ void expectOnSegments(const Surface& s, double epsilon, const std::string& what)
 /// 1-voxel of `image` (CGAL's ray-parity point-in-mesh).
 template <class BinaryImage>
 void expectVoxelSides(const Surface& s, const BinaryImage& image, Voxel lo, Voxel hi, const std::string& what) {
-  const ck::CgalMesh mesh = ck::cgalMesh(s.vertices, s.triangles);
-  CGAL::Side_of_triangle_mesh<ck::CgalMesh, ck::Kernel> side(mesh);
+  const ck::SideOfMesh side(s.vertices, s.triangles);
   std::size_t wrong = 0;
   for (int z = lo.z; z <= hi.z; ++z)
     for (int y = lo.y; y <= hi.y; ++y)
       for (int x = lo.x; x <= hi.x; ++x) {
         const auto p = s.geometry.toPhysical({double(x), double(y), double(z)});
-        const auto where = side(ck::Kernel::Point_3(p[0], p[1], p[2]));
-        const bool inside = where == CGAL::ON_BOUNDED_SIDE;
-        if (where == CGAL::ON_BOUNDARY || inside != bool(image(x, y, z)))
+        const ck::Side where = side({p[0], p[1], p[2]});
+        const bool inside = where == ck::Side::Inside;
+        if (where == ck::Side::Boundary || inside != bool(image(x, y, z)))
           if (++wrong <= 3) ADD_FAILURE() << what << ": voxel (" << x << "," << y << "," << z << ") is on the wrong side";
       }
 }
@@ -97,26 +96,24 @@ void expectVoxelSides(const Surface& s, const BinaryImage& image, Voxel lo, Voxe
 /// The voxel centres within one voxel of a surfel: those whose side could change.
 template <class BinaryImage>
 void expectVoxelSidesNearSurface(const Surface& s, const BinaryImage& image, const std::string& what) {
-  const ck::CgalMesh mesh = ck::cgalMesh(s.vertices, s.triangles);
-  CGAL::Side_of_triangle_mesh<ck::CgalMesh, ck::Kernel> side(mesh);
+  const ck::SideOfMesh side(s.vertices, s.triangles);
   std::size_t wrong = 0, checked = 0;
   for (const Surfel& sf : s.surfels)
     for (const Voxel v : {sf.inside(), sf.outside()}) {
       if (checked++ % 3) continue;  // a third of them: the classification is O(log F) each
       const auto p = s.geometry.toPhysical({double(v.x), double(v.y), double(v.z)});
-      const auto where = side(ck::Kernel::Point_3(p[0], p[1], p[2]));
-      const bool inside = where == CGAL::ON_BOUNDED_SIDE;
-      if (where == CGAL::ON_BOUNDARY || inside != bool(image(v.x, v.y, v.z)))
+      const ck::Side where = side({p[0], p[1], p[2]});
+      const bool inside = where == ck::Side::Inside;
+      if (where == ck::Side::Boundary || inside != bool(image(v.x, v.y, v.z)))
         if (++wrong <= 3) ADD_FAILURE() << what << ": voxel " << v << " is on the wrong side";
     }
 }
 
 /// Decimation's bounds: sampled distance both ways within maxError (plus rounding).
 void expectWithin(const Surface& original, const Surface& decimated, double maxError, const std::string& what) {
-  const ck::CgalMesh a = ck::cgalMesh(original.vertices, original.triangles);
-  const ck::CgalMesh b = ck::cgalMesh(decimated.vertices, decimated.triangles);
-  EXPECT_LE(ck::sampledDistance(original.vertices, original.triangles, b), maxError * (1 + 1e-6)) << what;
-  EXPECT_LE(ck::sampledDistance(decimated.vertices, decimated.triangles, a), maxError * (1 + 1e-6)) << what;
+  const Surface &a = original, &b = decimated;
+  EXPECT_LE(ck::sampledDistance(a.vertices, a.triangles, b.vertices, b.triangles), maxError * (1 + 1e-6)) << what;
+  EXPECT_LE(ck::sampledDistance(b.vertices, b.triangles, a.vertices, a.triangles), maxError * (1 + 1e-6)) << what;
 }
 
 Surface extractAll(const DenseImage<std::uint8_t>& image, AdjacencyPair pair) {
@@ -474,7 +471,7 @@ TEST(FoldCertificates, HoldAtEveryPositionInTheirBoxes) {
     const Voxel low = cube::cornerOffset(cube::edgeLowCorner(k));
     std::array<double, 3> p{double(low.x), double(low.y), double(low.z)};
     p[cube::edgeAxis(k)] += tau;
-    return ck::Kernel::Point_3(p[0], p[1], p[2]);
+    return p;
   };
   std::set<Edges> triangles;
   std::set<std::pair<Edges, Edges>> pairs;
@@ -499,11 +496,14 @@ TEST(FoldCertificates, HoldAtEveryPositionInTheirBoxes) {
     }
     ++certain;
     const auto m0 = at(t[0], 0.5), m1 = at(t[1], 0.5), m2 = at(t[2], 0.5);
-    const auto reference = CGAL::cross_product(m1 - m0, m2 - m0);
+    // The reference normal in doubles, as CGAL's inexact constructions compute it.
+    const ck::Point u{m1[0] - m0[0], m1[1] - m0[1], m1[2] - m0[2]}, w{m2[0] - m0[0], m2[1] - m0[1], m2[2] - m0[2]};
+    const ck::Point reference{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     for (int sample = 0; sample < 8 + 32; ++sample) {
       const int s = sample < 8 ? sample : 64 + sample;
       const auto a = at(t[0], position(s, 0)), b = at(t[1], position(s, 1)), c = at(t[2], position(s, 2));
-      ASSERT_EQ(CGAL::orientation(a, b, c, a + reference), CGAL::POSITIVE)
+      const ck::Point d{a[0] + reference[0], a[1] + reference[1], a[2] + reference[2]};
+      ASSERT_EQ(ck::orientation(a, b, c, d), 1)
           << "triangle " << int(t[0]) << "," << int(t[1]) << "," << int(t[2]);
     }
   }
@@ -526,9 +526,9 @@ TEST(FoldCertificates, HoldAtEveryPositionInTheirBoxes) {
       ck::Points points;
       for (std::size_t k = 0; k < edges.size(); ++k) {
         const auto p = at(edges[k], position(sample, int(k)));
-        points.push_back({p.x(), p.y(), p.z()});
+        points.push_back(p);
       }
-      ASSERT_EQ(ck::selfIntersections(ck::cgalMesh(points, faces)), 0u)
+      ASSERT_EQ(ck::selfIntersections(points, faces), 0u)
           << "pair " << int(t[0]) << "," << int(t[1]) << "," << int(t[2]) << " / " << int(u[0]) << "," << int(u[1])
           << "," << int(u[2]) << " at sample " << sample;
     }
