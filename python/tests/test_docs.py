@@ -22,5 +22,7 @@ def test_example(index, tmp_path, monkeypatch):
         needed = first[len("# needs: "):].split()[0]
         if not os.path.exists(needed):
             pytest.skip(f"{needed} is not installed")
+    if "distributed." in code and "asan" in os.environ.get("LD_PRELOAD", ""):
+        pytest.skip("Dask's worker processes are not run under the sanitizers (test_distributed.py)")
     monkeypatch.chdir(tmp_path)
     exec(compile(code, f"docs/python.md block {index + 1}", "exec"), {"__name__": "__docs__"})
