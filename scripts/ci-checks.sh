@@ -8,8 +8,8 @@
 #                   UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its
 #                   test). CI runs it last (.ci/run). Measured in CPU time (the 2-core machines
 #                   are shared, so wall-clock figures depend on the others' load): the build
-#                   670 CPU-seconds, the tests 295, at least 8 minutes on 2 idle cores (12.5 of
-#                   wall-clock time at load 2-5).
+#                   805 CPU-seconds (416 s), the tests 395 (234 s), on a fresh clone by .ci/run
+#                   with nothing else running (load 1.99).
 #                   Test oracles that are not code under test are compiled without the
 #                   sanitizers (the CGAL checks, test_cli's harness; tests/CMakeLists.txt), and
 #                   io/ReadVolume.cpp, ITK's templates, without UBSan (io/CMakeLists.txt).
