@@ -23,6 +23,7 @@
 #include <surftrack/ThresholdBlocks.h>
 
 #include "ChunkedSource.h"
+#include "ArrayChunkProvider.h"
 #include "ChunkedStore.h"  // io/: zarr, OME-Zarr, N5
 #include "ReadVolume.h"    // io/: ReadError
 #include "PrecomputedMesh.h"  // converter/: Neuroglancer's format
@@ -420,6 +421,18 @@ class SourceWithGeometry final : public VoxelSource {
 /// lazily through a cache of `cacheBytes` (ChunkedSource.h); engine x is the array's last axis.
 /// `spacing`, `origin`, `direction` (array axes) replace the store's geometry when given. The
 /// dict has the surface's fields and "chunks" (chunks in the store, decoded, bytes read, hits).
+/// What a chunk cache did, as Surface.chunks.
+py::dict chunkFigures(const ChunkCache& cache) {
+  const ChunkCacheCounters c = cache.counters();
+  const Dims n = cache.layout().chunkCounts();
+  py::dict chunks;
+  chunks["chunks"] = std::uint64_t(n.nx) * std::uint64_t(n.ny) * std::uint64_t(n.nz);
+  chunks["decoded"] = c.chunksDecoded;
+  chunks["bytes_read"] = c.bytesRead;
+  chunks["hits"] = c.hits;
+  return chunks;
+}
+
 py::dict extractStore(const std::string& path, int level, std::optional<std::int64_t> channel,
                       std::optional<std::int64_t> time, std::size_t cacheBytes, const std::string& selectionKind,
                       py::object value, const std::string& seedKind, std::array<double, 6> seed,
@@ -464,14 +477,46 @@ py::dict extractStore(const std::string& path, int level, std::optional<std::int
   } catch (const io::ReadError& e) {
     throw py::value_error(e.what());  // a chunk that cannot be decoded
   }
-  const ChunkCacheCounters c = cache->counters();
-  const Dims n = cache->layout().chunkCounts();
-  py::dict chunks;
-  chunks["chunks"] = std::uint64_t(n.nx) * std::uint64_t(n.ny) * std::uint64_t(n.nz);
-  chunks["decoded"] = c.chunksDecoded;
-  chunks["bytes_read"] = c.bytesRead;
-  chunks["hits"] = c.hits;
-  out["chunks"] = chunks;
+  out["chunks"] = chunkFigures(*cache);
+  return out;
+}
+
+/// extract() on an array that only Python reads (python/src/ArrayChunkProvider.h): `shape`
+/// and `chunks` in the array's axes [z, y, x], `dtype` the native type each slice becomes;
+/// spacing, origin and direction as extractArray's.
+py::dict extractChunked(py::object array, std::array<std::int64_t, 3> shape, std::array<std::int64_t, 3> chunks,
+                        py::dtype dtype, std::size_t cacheBytes, const std::string& selectionKind,
+                        py::object value, const std::string& seedKind, std::array<double, 6> seed,
+                        const std::string& adjacency, const std::string& mapping, double epsilon,
+                        std::array<double, 3> spacing, std::array<double, 3> origin,
+                        std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
+                        py::object progress, int smoothIterations, std::optional<double> maxError,
+                        std::optional<double> reduction, double maxSeedDistance) {
+  ChunkLayout layout;
+  layout.type = scalarTypeOfDtype(dtype);
+  for (int e = 0; e < 3; ++e) {
+    const int a = kLastAxisFirst[e];
+    if (shape[a] < 1 || shape[a] > kMaxDimension)
+      throw py::value_error("volume shape: each dimension must be 1 to " + std::to_string(kMaxDimension));
+    if (chunks[a] < 1) throw py::value_error("chunk shape: each dimension must be at least 1");
+    (e == 0 ? layout.dims.nx : e == 1 ? layout.dims.ny : layout.dims.nz) = int(shape[a]);
+    (e == 0 ? layout.chunk.nx : e == 1 ? layout.chunk.ny : layout.chunk.nz) = int(std::min(chunks[a], shape[a]));
+    layout.geometry.spacing[e] = spacing[a];
+    for (int k = 0; k < 3; ++k) layout.geometry.direction[k][e] = direction[k][a];
+  }
+  layout.geometry.origin = origin;
+  const auto provider = std::make_shared<const python::ArrayChunkProvider>(std::move(array), layout, dtype);
+  const auto cache = std::make_shared<const ChunkCache>(provider, cacheBytes);
+  const std::unique_ptr<VoxelSource> source = makeChunkedSource(cache);
+  py::dict out;
+  try {
+    out = extractWith([&](const ExtractOptions& o) { return extract(*source, o); }, kLastAxisFirst, selectionKind,
+                      value, seedKind, seed, adjacency, mapping, epsilon, threads, figures, progress,
+                      smoothIterations, maxError, reduction, maxSeedDistance);
+  } catch (const io::ReadError& e) {
+    throw py::value_error(e.what());  // a slice that failed or came back wrong
+  }
+  out["chunks"] = chunkFigures(*cache);
   return out;
 }
 
@@ -770,6 +815,7 @@ PYBIND11_MODULE(_surftrack, m) {
       .def("surfels", &Result::surfels);
   m.def("extract_array", &extractArray);
   m.def("extract_store", &extractStore);
+  m.def("extract_chunked", &extractChunked);
   m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
   m.def("write_precomputed", &writePrecomputed);

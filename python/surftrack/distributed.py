@@ -75,31 +75,57 @@ def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir):
     return str(path), {f[0]: (len(f[2]), len(f[3])) for f in fragments}
 
 
+#: Fragment bytes a reduce task holds at most (about): the plan makes more shards than asked
+#: for when the fragments would exceed it.
+_SHARD_BYTES = 512 << 20
+
+
 def _plan(results, shards):
-    """Task: label -> its blocks' files, the labels dealt to `shards` shards by vertex count
-    (largest first, each to the lightest shard)."""
+    """Task: the labels cut into shards, each a list of (label, its blocks' files). Labels in the
+    order of their first block (neighbours together, so that a shard reads few files), cut into
+    runs of about equal fragment bytes: at least `shards` runs, and enough that none holds much
+    more than _SHARD_BYTES (a keys entry is 8 bytes, a triangle 12)."""
     where, weight = {}, {}
-    for path, summary in results:
-        for label, (keys, _) in summary.items():
-            where.setdefault(label, []).append(path)
-            weight[label] = weight.get(label, 0) + keys
-    load = [0] * shards
-    plan = [[] for _ in range(shards)]
-    for label in sorted(where, key=lambda L: (-weight[L], L)):
-        s = load.index(min(load))
-        plan[s].append((label, where[label]))
-        load[s] += weight[label]
-    return [p for p in plan if p]
+    for order, (path, summary) in enumerate(results):
+        for label, (keys, triangles) in summary.items():
+            where.setdefault(label, []).append((order, path))
+            weight[label] = weight.get(label, 0) + 8 * keys + 12 * triangles
+    labels = sorted(where, key=lambda L: (where[L][0][0], L))
+    total = sum(weight.values())
+    count = max(1, min(len(labels), max(shards, -(-total // _SHARD_BYTES))))
+    plan, run, filled = [], [], 0
+    for label in labels:
+        run.append((label, [path for _, path in where[label]]))
+        filled += weight[label]
+        if filled * count >= total * (len(plan) + 1) and len(plan) < count - 1:
+            plan.append(run)
+            run = []
+    if run:
+        plan.append(run)
+    return plan
 
 
-def _merge_label(label, paths, geometry, background, adjacency, figures):
-    fragments = []
-    for path in paths:
+def _shard_fragments(shard):
+    """(label, file) -> (voxels, keys, triangles) for every label of a shard, each file read
+    once (a label's fragments sliced out of it; the rest of the file dropped)."""
+    wanted = {}
+    for label, paths in shard:
+        for path in paths:
+            wanted.setdefault(path, set()).add(label)
+    out = {}
+    for path, labels in wanted.items():
         with np.load(path) as f:
-            i = [int(s) for s in f["labels"]].index(label)
-            k0, k1 = f["key_offsets"][i:i + 2]
-            t0, t1 = f["triangle_offsets"][i:i + 2]
-            fragments.append((int(f["voxels"][i]), f["keys"][k0:k1], f["triangles"][t0:t1]))
+            names = [int(s) for s in f["labels"]]
+            ko, to, voxels = f["key_offsets"], f["triangle_offsets"], f["voxels"]
+            keys, triangles = f["keys"], f["triangles"]
+            for i, label in enumerate(names):
+                if label in labels:
+                    out[label, path] = (int(voxels[i]), keys[ko[i]:ko[i + 1]].copy(),
+                                        triangles[to[i]:to[i + 1]].copy())
+    return out
+
+
+def _merge_label(label, fragments, geometry, background, adjacency, figures):
     spacing, origin, direction = geometry
     return _surftrack.merge_label_fragments(label, fragments, spacing, origin, direction, background,
                                             adjacency, figures)
@@ -110,8 +136,10 @@ def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir):
     (the files only, returned as figures), else the surfaces' fields returned."""
     from . import Surface
     out = {}
+    fragments = _shard_fragments(shard)
     for label, paths in shard:
-        fields = _merge_label(label, paths, geometry, background, adjacency, figures)
+        fields = _merge_label(label, [fragments.pop((label, p)) for p in paths], geometry, background,
+                              adjacency, figures)
         if out_dir is None:  # plain arrays through the scheduler (the C++ result does not pickle)
             result = fields.pop("result")
             fields["surfels"], fields["normals"] = result.surfels(), result.normals()
