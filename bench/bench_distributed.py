@@ -7,12 +7,16 @@ of C Voronoi cells (default 2,500; uniform random centres, fixed seed, labels 1.
 Runs, in the same run:
   - the single pass in memory: `surftrack labels RAW -o DIR/label_{label}.ply` (the raw file
     page-cached; all cores), and the same from the store (decoded whole first);
+  - the single pass in Python, the reference of the Dask runs: surftrack.label_surfaces on the
+    raw file memory-mapped (all cores), each label written as label_<L>.ply (Python's vertices
+    are in the array's axes z, y, x, the CLI's in x, y, z: the two sets of files differ);
   - surftrack.distributed.write_label_meshes(zarr array, DIR) on a LocalCluster of W worker
     processes (one thread each, memory limit --worker-gib each), W = 1 and 2, blocks --block;
     the fragment files in a fresh work directory each time; the workers' peak resident sets
     (getrusage in each worker) and the stages' times (blocks, labels) from the progress calls.
-Refuses to time a wrong answer: every Dask output directory must hold the same files as the
-single pass, byte for byte; the label count must be C.
+Refuses to report a wrong answer: every Dask output directory must hold the same files as
+Python's single pass, byte for byte; the CLI's from the store those of the raw file; the label
+count must be C.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/bench_distributed.py [--build build]
         [--dir /tmp/surftrack-dask] [--size 1024] [--cells 2500] [--block 256] [--workers 1,2]
@@ -86,6 +90,15 @@ def same_files(a, b):
     return not mismatch and not errors
 
 
+PYTHON_SINGLE = r'''
+import sys, numpy as np, surftrack
+raw, n, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+labels = np.memmap(raw, dtype="<u4", mode="r", shape=(n, n, n))
+for label, surface in surftrack.label_surfaces(labels, threads=0).items():
+    surface.write(f"{out}/label_{label}.ply")
+'''
+
+
 def peak_rss_mib():
     import resource
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
@@ -130,6 +143,14 @@ def main():
     if not same_files(single, other):
         sys.exit("bench_distributed: the single pass from the store differs from the raw file's")
     print(f"single pass, store decoded whole, 2 threads: {wall:.1f} s, peak RSS {rss:.0f} MiB", flush=True)
+    reference = os.path.join(args.dir, "python-single")
+    shutil.rmtree(reference, ignore_errors=True)
+    os.makedirs(reference)
+    wall, rss = timed(["/usr/bin/python3", "-c", PYTHON_SINGLE, raw, str(n), reference])
+    if len(os.listdir(reference)) != args.cells:
+        sys.exit("bench_distributed: Python's single pass wrote another number of labels")
+    print(f"single pass in Python (label_surfaces + write), 2 threads: {wall:.1f} s, peak RSS {rss:.0f} MiB",
+          flush=True)
     array = zarr.open(os.path.join(store, "0"), mode="r")
     for workers in [int(w) for w in args.workers.split(",")]:
         out = os.path.join(args.dir, f"dask-{workers}")
@@ -151,7 +172,8 @@ def main():
             wall = time.perf_counter() - t0
             peaks = client.run(peak_rss_mib)
         cluster.close()
-        if not same_files(single, out):
+        print(f"  ({workers} worker(s): {wall:.1f} s; comparing with Python's single pass)", flush=True)
+        if not same_files(reference, out):
             sys.exit(f"bench_distributed: {workers} workers: the output differs from the single pass")
         fragments = sum(os.path.getsize(os.path.join(work, f)) for f in os.listdir(work))
         print(f"Dask, {workers} worker(s) x 1 thread, {args.worker_gib:g} GiB each, blocks {args.block}^3: "
