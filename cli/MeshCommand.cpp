@@ -13,28 +13,6 @@ namespace surftrack::cli {
 
 namespace {
 
-/// A source whose voxels are another's and whose geometry is `geometry`: --frame, --spacing and
-/// --origin on a chunked store read lazily (its layout's geometry is the store's).
-class WithGeometry final : public VoxelSource {
- public:
-  WithGeometry(std::unique_ptr<VoxelSource> source, const ImageGeometry& geometry)
-      : source_(std::move(source)), geometry_(geometry) {}
-  Dims dims() const override { return source_->dims(); }
-  ImageGeometry geometry() const override { return geometry_; }
-  ScalarType type() const override { return source_->type(); }
-  void binaryBlock(const Selection& s, Voxel origin, int width, int ny, int nz, std::uint16_t* out) const override {
-    source_->binaryBlock(s, origin, width, ny, nz, out);
-  }
-  std::uint64_t binaryRow(const Selection& s, Voxel start, int count) const override {
-    return source_->binaryRow(s, start, count);
-  }
-  void values(const Voxel* voxels, std::size_t n, double* out) const override { source_->values(voxels, n, out); }
-
- private:
-  std::unique_ptr<VoxelSource> source_;
-  ImageGeometry geometry_;
-};
-
 /// A seeded extraction with --iso or --label from a chunked store, read lazily: only the chunks
 /// the surface crosses are decoded, through a cache of --cache MiB (docs/cli.md, "Input formats").
 void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progress& progress, int stages) {
@@ -43,7 +21,8 @@ void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progr
   const ChunkLayout& layout = cache->layout();
   ImageGeometry geometry = layout.geometry;
   x.frame = applyGeometryOptions(o.input, geometry, x.frame);
-  const WithGeometry source(makeChunkedSource(cache), geometry);
+  const std::unique_ptr<VoxelSource> chunked = makeChunkedSource(cache, geometry);
+  const VoxelSource& source = *chunked;
   clock.lap(x.timings, "read");
   x.input = o.input.path;
   x.dims = layout.dims;

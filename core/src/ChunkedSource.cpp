@@ -243,11 +243,11 @@ ChunkRange chunksOf(int lo, int hi, int chunk) { return {lo / chunk, (hi - 1) / 
 template <class T>
 class ChunkedSource final : public VoxelSource {
  public:
-  explicit ChunkedSource(std::shared_ptr<const ChunkCache> cache)
-      : cache_(std::move(cache)), layout_(cache_->layout()) {}
+  ChunkedSource(std::shared_ptr<const ChunkCache> cache, const ImageGeometry& geometry)
+      : cache_(std::move(cache)), layout_(cache_->layout()), geometry_(geometry) {}
 
   Dims dims() const override { return layout_.dims; }
-  ImageGeometry geometry() const override { return layout_.geometry; }
+  ImageGeometry geometry() const override { return geometry_; }
   ScalarType type() const override { return scalarTypeOf<T>(); }
 
   void binaryBlock(const Selection& selection, Voxel origin, int width, int ny, int nz,
@@ -358,14 +358,17 @@ class ChunkedSource final : public VoxelSource {
 
   std::shared_ptr<const ChunkCache> cache_;
   ChunkLayout layout_;
+  ImageGeometry geometry_;
 };
 
 }  // namespace
 
-std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache) {
+std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache,
+                                               std::optional<ImageGeometry> geometry) {
   if (!cache) throw InvalidInput("the chunked source has no chunk cache (null pointer)");
+  const ImageGeometry g = geometry.value_or(cache->layout().geometry);
   return visitScalarType(cache->layout().type, [&](auto v) -> std::unique_ptr<VoxelSource> {
-    return std::make_unique<ChunkedSource<decltype(v)>>(cache);
+    return std::make_unique<ChunkedSource<decltype(v)>>(cache, g);
   });
 }
 

@@ -396,31 +396,6 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
                      maxError, reduction, maxSeedDistance);
 }
 
-/// A source whose voxels are another's and whose geometry is given (a store's geometry
-/// replaced by the caller's spacing, origin, direction).
-class SourceWithGeometry final : public VoxelSource {
- public:
-  SourceWithGeometry(const VoxelSource& source, const ImageGeometry& geometry) : source_(source), geometry_(geometry) {}
-  Dims dims() const override { return source_.dims(); }
-  ImageGeometry geometry() const override { return geometry_; }
-  ScalarType type() const override { return source_.type(); }
-  void binaryBlock(const Selection& s, Voxel origin, int width, int ny, int nz, std::uint16_t* out) const override {
-    source_.binaryBlock(s, origin, width, ny, nz, out);
-  }
-  std::uint64_t binaryRow(const Selection& s, Voxel start, int count) const override {
-    return source_.binaryRow(s, start, count);
-  }
-  void values(const Voxel* voxels, std::size_t n, double* out) const override { source_.values(voxels, n, out); }
-
- private:
-  const VoxelSource& source_;
-  ImageGeometry geometry_;
-};
-
-/// extract() from the chunked store at `path` (zarr, OME-Zarr, N5: io/ChunkedStore.h), read
-/// lazily through a cache of `cacheBytes` (ChunkedSource.h); engine x is the array's last axis.
-/// `spacing`, `origin`, `direction` (array axes) replace the store's geometry when given. The
-/// dict has the surface's fields and "chunks" (chunks in the store, decoded, bytes read, hits).
 /// What a chunk cache did, as Surface.chunks.
 py::dict chunkFigures(const ChunkCache& cache) {
   const ChunkCacheCounters c = cache.counters();
@@ -452,10 +427,9 @@ py::dict extractStore(const std::string& path, int level, std::optional<std::int
     throw py::value_error(e.what());
   }
   const auto cache = std::make_shared<const ChunkCache>(store.provider, cacheBytes);
-  const std::unique_ptr<VoxelSource> chunked = makeChunkedSource(cache);
   // Python's coordinates follow the array's axes (z, y, x for a store): the store's physical
   // rows (x, y, z) reversed.
-  const ImageGeometry stored = chunked->geometry();
+  const ImageGeometry stored = cache->layout().geometry;
   ImageGeometry g = stored;
   for (int k = 0; k < 3; ++k) {
     g.origin[k] = stored.origin[2 - k];
@@ -468,7 +442,8 @@ py::dict extractStore(const std::string& path, int level, std::optional<std::int
       for (int k = 0; k < 3; ++k) g.direction[k][e] = (*direction)[k][a];
   }
   if (origin) g.origin = *origin;
-  const SourceWithGeometry source(*chunked, g);
+  const std::unique_ptr<VoxelSource> chunked = makeChunkedSource(cache, g);
+  const VoxelSource& source = *chunked;
   py::dict out;
   try {
     out = extractWith([&](const ExtractOptions& o) { return extract(source, o); }, kLastAxisFirst, selectionKind,

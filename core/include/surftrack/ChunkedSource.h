@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "Geometry.h"
 #include "ScalarType.h"
@@ -89,7 +90,9 @@ class ChunkCache {
 
 /// A source reading through `cache` (shared: its counters stay readable after extraction).
 /// Voxels outside layout().dims are 0-voxels, as for every source; a chunk's edge is never the
-/// domain's edge.
-std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache);
+/// domain's edge. `geometry`, when given, is the one the source reports instead of the
+/// layout's: the caller's spacing, origin or frame over a store's voxels.
+std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache,
+                                               std::optional<ImageGeometry> geometry = std::nullopt);
 
 }  // namespace surftrack
