@@ -5,6 +5,7 @@ blocks and a single block included), byte-identical PLY files from a zarr store,
 around 2^53 and 2^64 - 1 exact, a resumed run that recomputes no finished block, a worker killed
 mid-run that changes nothing, and bad input refused before the run."""
 import os
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -145,3 +146,78 @@ def test_bad_input_is_refused_before_the_run(client, tmp_path):
     with pytest.raises(ValueError, match="not an empty directory"):
         blocks.write_label_meshes(labels, full, client=client)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["full"]
+
+
+def test_a_work_dir_reused_with_other_arguments_recomputes(client, tmp_path):
+    # The fragments depend on the background (and the pair, the block, the array): a second run
+    # in the same work_dir with another background must not merge the first run's fragments.
+    labels = random_labels(np.random.default_rng(23), (10, 9, 11))
+    work = tmp_path / "fragments"
+    blocks.label_surfaces(labels, block=(5, 5, 5), client=client, work_dir=work)
+    other = blocks.label_surfaces(labels, block=(5, 5, 5), client=client, work_dir=work, background=int(IDS[1]))
+    expect_same(other, surftrack.label_surfaces(labels, background=int(IDS[1])))
+    assert len(list(work.iterdir())) == 2 * len(blocks.block_grid(labels.shape, (5, 5, 5)))
+
+
+THRESHOLD_CASES = [(np.float32, "linear"), (np.uint8, "midpoint"), (">f8", "linear"), (np.int16, "linear"),
+                   (bool, "midpoint")]
+
+
+@pytest.mark.parametrize("dtype,mapping", THRESHOLD_CASES)
+def test_threshold_blocks_merge_to_the_single_pass(client, dtype, mapping):
+    rng = np.random.default_rng(zlib.crc32(repr((dtype, mapping)).encode()))
+    for trial, block in enumerate([(4, 3, 5), (1, 6, 2), (30, 30, 30), (5, 1, 7)]):
+        shape = tuple(int(n) for n in rng.integers(6, 12, size=3))
+        volume = (rng.random(shape) * 200).astype(dtype) if dtype is not bool else rng.random(shape) > 0.6
+        level = 0.5 if dtype is bool else 120.5
+        adjacency = ["26-6", "18-6", "6-18", "6-26"][trial]
+        spacing = tuple(float(s) for s in rng.uniform(0.5, 2.0, size=3))
+        want = surftrack.extract(volume, level=level, mode="all", mapping=mapping, adjacency=adjacency,
+                                 spacing=spacing, origin=(1, -2, 3), threads=1)
+        got = blocks.threshold_surface(volume, level, block=block, mapping=mapping, adjacency=adjacency,
+                                       spacing=spacing, origin=(1, -2, 3), client=client)
+        assert got.vertices.tobytes() == want.vertices.tobytes()
+        assert np.array_equal(got.faces, want.faces) and np.array_equal(got.surfels, want.surfels)
+        assert got.euler == want.euler and got.components == want.components
+
+
+def test_threshold_mesh_from_a_zarr_store_is_byte_identical_and_resumes(client, tmp_path):
+    rng = np.random.default_rng(29)
+    shape = (41, 37, 33)
+    z, y, x = np.indices(shape)
+    volume = (np.sin(x / 4.0) + np.cos(y / 5.0) * np.sin(z / 3.0) + rng.normal(0, 0.05, shape)).astype(np.float32)
+    zarr.open(str(tmp_path / "v.zarr"), mode="w", shape=shape, chunks=(9, 10, 11), dtype="<f4")[:] = volume
+    source = zarr.open(str(tmp_path / "v.zarr"), mode="r")
+    seen = []
+    work = tmp_path / "fragments"
+    figures = blocks.write_threshold_mesh(source, tmp_path / "a.ply", 0.25, block=(16, 20, 12), spacing=(3, 2, 1),
+                                          client=client, work_dir=work,
+                                          progress=lambda stage, done, total: seen.append((stage, done, total)))
+    want = surftrack.extract(volume, level=0.25, mode="all", spacing=(3, 2, 1), threads=1)
+    want.write(str(tmp_path / "b.ply"))
+    assert (tmp_path / "a.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
+    assert figures["vertices"] == len(want.vertices) and figures["euler"] == want.euler
+    assert figures["boundaries"] == len(want.components) == 3  # (two of genus 4 and a speck)
+    assert ("blocks", 18, 18) in seen and seen[-1] == ("merge", 1, 1)
+    stamps = {p.name: p.stat().st_mtime_ns for p in work.iterdir()}
+    blocks.write_threshold_mesh(source, tmp_path / "c.ply", 0.25, block=(16, 20, 12), spacing=(3, 2, 1),
+                                client=client, work_dir=work)
+    assert {p.name: p.stat().st_mtime_ns for p in work.iterdir()} == stamps
+    assert (tmp_path / "c.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
+    # Another level in the same work_dir: recomputed, not the first level's fragments.
+    blocks.write_threshold_mesh(source, tmp_path / "d.ply", 0.5, block=(16, 20, 12), spacing=(3, 2, 1),
+                                client=client, work_dir=work)
+    surftrack.extract(volume, level=0.5, mode="all", spacing=(3, 2, 1), threads=1).write(str(tmp_path / "e.ply"))
+    assert (tmp_path / "d.ply").read_bytes() == (tmp_path / "e.ply").read_bytes()
+
+
+def test_threshold_bad_input(client):
+    volume = np.zeros((6, 6, 6), np.float32)
+    with pytest.raises(ValueError, match="mapping"):
+        blocks.threshold_surface(volume, 0.5, mapping="cubic", client=client)
+    with pytest.raises(ValueError, match="finite"):
+        blocks.threshold_surface(volume, float("nan"), client=client)
+    with pytest.raises(ValueError, match="3-D"):
+        blocks.threshold_surface(volume[0], 0.5, client=client)
+    with pytest.raises(ValueError, match="adjacency"):
+        blocks.threshold_surface(volume, 0.5, adjacency="8-4", client=client)
