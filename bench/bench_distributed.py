@@ -20,10 +20,11 @@ count must be C.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/bench_distributed.py [--build build]
         [--dir /tmp/surftrack-dask] [--size 1024] [--cells 2500] [--block 256] [--workers 1,2]
-        [--worker-gib 3] [--generate-only]
+        [--worker-gib 3] [--generate-only] [--calibration bench/dask-calibration.json]
 """
 import argparse
 import filecmp
+import json
 import os
 import shutil
 import subprocess
@@ -114,6 +115,7 @@ def main():
     ap.add_argument("--workers", default="1,2")
     ap.add_argument("--worker-gib", type=float, default=3.0)
     ap.add_argument("--generate-only", action="store_true")
+    ap.add_argument("--calibration", help="write the 1-worker run's costs here, for bench/model_distributed.py")
     args = ap.parse_args()
     store, raw = generate(args.dir, args.size, args.cells)
     if args.generate_only:
@@ -176,6 +178,17 @@ def main():
         if not same_files(reference, out):
             sys.exit(f"bench_distributed: {workers} workers: the output differs from the single pass")
         fragments = sum(os.path.getsize(os.path.join(work, f)) for f in os.listdir(work))
+        if workers == 1 and args.calibration:
+            def size(d):
+                return sum(os.path.getsize(os.path.join(r, f)) for r, _, fs in os.walk(d) for f in fs)
+            with open(args.calibration, "w") as f:
+                json.dump({"source": f"bench/bench_distributed.py, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
+                                     f"load {open('/proc/loadavg').read().split()[0]}: {n}^3 uint32 Voronoi of "
+                                     f"{args.cells} cells, 1 worker process",
+                           "voxels": n ** 3, "dtype": "uint32", "itemsize": 4, "block": args.block,
+                           "map_seconds": stages["blocks"], "reduce_seconds": wall - stages["blocks"],
+                           "fragment_bytes": fragments, "store_bytes": size(store), "output_bytes": size(out)},
+                          f, indent=2)
         print(f"Dask, {workers} worker(s) x 1 thread, {args.worker_gib:g} GiB each, blocks {args.block}^3: "
               f"{wall:.1f} s ({wall / base:.2f} x the single pass), blocks done at {stages.get('blocks', 0):.1f} s, "
               f"worker peak RSS {', '.join(f'{p:.0f}' for p in peaks.values())} MiB, fragments "
