@@ -632,6 +632,7 @@ void parseLabelList(const std::string& text, LabelsOptions& o) {
 struct LabelsArgs {
   std::string labels;               ///< --labels, parsed by parseLabelList
   std::vector<std::string> seeds;   ///< --seed, each x,y,z
+  std::string block;                ///< --block BX,BY,BZ
   InputArgs input;
 };
 
@@ -685,6 +686,21 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
       ->option_text("FILE")
       ->group(which);
   app.add_flag("--no-label-names", o.noNames, "ignore the sidecar names")->group(which);
+  const std::string dask = "by blocks on Dask (a chunked store, -o DIR/)";
+  app.add_option("--dask", o.dask, "local:N (N worker processes here) or a Dask scheduler's address\n"
+                 "(tcp://host:8786): the same files and table as the single pass, each\n"
+                 "block meshed by a worker, no volume in one memory (docs/cli.md)")
+      ->option_text("ADDRESS")
+      ->group(dask);
+  app.add_option("--block", args.block, "the blocks' size in voxels (default 256,256,256)")
+      ->option_text("BX,BY,BZ")
+      ->check(tripleOf({kInteger, explained(CLI::Range(1LL, kMaxDim), "a block size is 1 to 524285 voxels")},
+                       "expected three integers BX,BY,BZ"))
+      ->group(dask);
+  app.add_option("--work-dir", o.workDir, "where the blocks' fragment files go, seen by every worker\n"
+                 "(default: a temporary directory); kept, so that a run again resumes")
+      ->option_text("DIR")
+      ->group(dask);
   addSurfaceOptions(app, o.pair, o.ascii, o.threads,
                     "threads for the scan and the labels (default 0: all cores);\n"
                     "the meshes are the same for any number");
@@ -780,6 +796,15 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
     o.seeds.push_back(Voxel{int(*toInteger(parts[0])), int(*toInteger(parts[1])), int(*toInteger(parts[2]))});
   }
   if (o.largest && !o.seeds.empty()) throw UsageError("give --largest or --seed, not both");
+  if (!a.block.empty()) {
+    const auto parts = splitCommas(a.block);
+    for (int k = 0; k < 3; ++k) o.block[std::size_t(k)] = int(*toInteger(parts[std::size_t(k)]));
+  }
+  if (o.dask.empty() && (!a.block.empty() || !o.workDir.empty()))
+    throw UsageError("--block and --work-dir are for --dask");
+  if (!o.dask.empty() && (o.largest || !o.seeds.empty() || !o.labels.empty() || o.range || !o.format.empty()))
+    throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest, "
+                     "--seed or --format yet");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
   if (!o.unit.empty() && o.format != "precomputed") throw UsageError("--unit is for --format precomputed");
   if (o.format == "precomputed" && (o.output.find('{') != std::string::npos ||

@@ -114,6 +114,11 @@ struct LabelsOptions {
   /// instead of one mesh file per label.
   std::string format;
   std::string unit;   ///< --unit U: the physical unit of the volume's spacing (precomputed output)
+  /// --dask ADDRESS: a chunked store meshed by blocks on Dask (cli/DaskLabels.h): "local:N" or a
+  /// scheduler's address ("tcp://host:8786"); empty: the single pass.
+  std::string dask;
+  std::array<int, 3> block{256, 256, 256};  ///< --block BX,BY,BZ (with --dask)
+  std::string workDir;                      ///< --work-dir DIR (with --dask): fragments kept, a run resumes
   OutputOptions out;
 };
 

@@ -5,6 +5,7 @@
 // image returns 0 for every voxel outside its chunk, so the rows of the chunks OR together into
 // the row of the whole array.
 #include <algorithm>
+#include <cstring>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -362,6 +363,42 @@ class ChunkedSource final : public VoxelSource {
 };
 
 }  // namespace
+
+void copyBox(const ChunkCache& cache, Voxel lo, Dims extent, void* out) {
+  const ChunkLayout& layout = cache.layout();
+  for (int a = 0; a < 3; ++a)
+    if (lo[a] < 0 || extent[a] < 1 || std::int64_t(lo[a]) + extent[a] > layout.dims[a])
+      throw InvalidInput("the box from (" + std::to_string(lo.x) + ", " + std::to_string(lo.y) + ", " +
+                         std::to_string(lo.z) + ") of " + std::to_string(extent.nx) + " x " +
+                         std::to_string(extent.ny) + " x " + std::to_string(extent.nz) +
+                         " voxels is not inside the array");
+  const std::size_t item = sizeOf(layout.type);
+  const ChunkRange cx = chunksOf(lo.x, lo.x + extent.nx, layout.chunk.nx),
+                   cy = chunksOf(lo.y, lo.y + extent.ny, layout.chunk.ny),
+                   cz = chunksOf(lo.z, lo.z + extent.nz, layout.chunk.nz);
+  auto* to = static_cast<unsigned char*>(out);
+  for (int iz = cz.first; iz <= cz.last; ++iz)
+    for (int iy = cy.first; iy <= cy.last; ++iy)
+      for (int ix = cx.first; ix <= cx.last; ++ix) {
+        const std::shared_ptr<const DecodedChunk> c = cache.chunk({ix, iy, iz});
+        const auto* from = static_cast<const unsigned char*>(c->data);
+        Voxel a, b;  // the part of the box in this chunk, in array coordinates
+        for (int k = 0; k < 3; ++k) {
+          a[k] = std::max(lo[k], c->origin[k]);
+          b[k] = std::min(lo[k] + extent[k], c->origin[k] + c->extent[k]);
+        }
+        const std::size_t run = std::size_t(b.x - a.x) * item;
+        for (int z = a.z; z < b.z; ++z)
+          for (int y = a.y; y < b.y; ++y) {
+            const std::size_t src = ((std::size_t(z - c->origin.z) * std::size_t(c->extent.ny) +
+                                      std::size_t(y - c->origin.y)) * std::size_t(c->extent.nx) +
+                                     std::size_t(a.x - c->origin.x)) * item;
+            const std::size_t dst = ((std::size_t(z - lo.z) * std::size_t(extent.ny) + std::size_t(y - lo.y)) *
+                                         std::size_t(extent.nx) + std::size_t(a.x - lo.x)) * item;
+            std::memcpy(to + dst, from + src, run);
+          }
+      }
+}
 
 std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache,
                                                std::optional<ImageGeometry> geometry) {

@@ -495,6 +495,66 @@ py::dict extractChunked(py::object array, std::array<std::int64_t, 3> shape, std
   return out;
 }
 
+/// The chunked store at `path` (its level, channel and time chosen), for the block tasks of the
+/// command line's --dask (python/surftrack/_cli_dask.py).
+io::ChunkedStore openStore(const std::string& path, int level, std::optional<std::int64_t> channel,
+                           std::optional<std::int64_t> time) {
+  io::ChunkedStoreOptions chosen;
+  chosen.level = level;
+  chosen.channel = channel;
+  chosen.time = time;
+  try {
+    return io::openChunkedStore(path, chosen);
+  } catch (const io::ReadError& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+/// numpy's name of a voxel type, native byte order.
+std::string dtypeName(ScalarType type) {
+  switch (type) {
+    case ScalarType::UInt8: return "uint8";
+    case ScalarType::Int8: return "int8";
+    case ScalarType::UInt16: return "uint16";
+    case ScalarType::Int16: return "int16";
+    case ScalarType::UInt32: return "uint32";
+    case ScalarType::Int32: return "int32";
+    case ScalarType::UInt64: return "uint64";
+    case ScalarType::Int64: return "int64";
+    case ScalarType::Float32: return "float32";
+    case ScalarType::Float64: return "float64";
+  }
+  throw py::value_error("unknown voxel type");
+}
+
+/// (shape [z, y, x], dtype name) of a store's chosen array.
+py::tuple storeLayout(const std::string& path, int level, std::optional<std::int64_t> channel,
+                      std::optional<std::int64_t> time) {
+  const ChunkLayout& l = openStore(path, level, channel, time).provider->layout();
+  return py::make_tuple(py::make_tuple(l.dims.nz, l.dims.ny, l.dims.nx), dtypeName(l.type));
+}
+
+/// The voxels [lo, hi) (array axes [z, y, x]) of a store's chosen array, each chunk decoded once.
+py::array readStoreBox(const std::string& path, int level, std::optional<std::int64_t> channel,
+                       std::optional<std::int64_t> time, std::array<int, 3> lo, std::array<int, 3> hi) {
+  const io::ChunkedStore store = openStore(path, level, channel, time);
+  const ChunkCache cache(store.provider, 0);  // (copyBox visits each chunk once)
+  const Voxel at{lo[2], lo[1], lo[0]};
+  const Dims extent{hi[2] - lo[2], hi[1] - lo[1], hi[0] - lo[0]};
+  py::array out(py::dtype(dtypeName(store.provider->layout().type)),
+                {py::ssize_t(std::max(extent.nz, 0)), py::ssize_t(std::max(extent.ny, 0)), py::ssize_t(std::max(extent.nx, 0))});
+  void* data = out.mutable_data();
+  try {
+    py::gil_scoped_release release;
+    copyBox(cache, at, extent, data);
+  } catch (const io::ReadError& e) {
+    throw py::value_error(e.what());
+  } catch (const InvalidInput& e) {
+    throw py::value_error(e.what());
+  }
+  return out;
+}
+
 /// Runs extractLabels() on `volume` (engine axes order[0..2]): a dict label -> surfaceDict.
 py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const std::string& selectionKind,
                             py::list labels, py::list range, py::object background,
@@ -791,6 +851,8 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("extract_array", &extractArray);
   m.def("extract_store", &extractStore);
   m.def("extract_chunked", &extractChunked);
+  m.def("store_layout", &storeLayout);
+  m.def("read_store_box", &readStoreBox);
   m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
   m.def("write_precomputed", &writePrecomputed);

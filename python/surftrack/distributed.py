@@ -140,9 +140,18 @@ def _merge_label(label, fragments, geometry, background, adjacency, figures):
                                             adjacency, figures)
 
 
-def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir):
-    """Task: every label of a shard merged; written as DIR/label_<L>.ply when `out_dir` is given
-    (the files only, returned as figures), else the surfaces' fields returned."""
+def _file_name(label, naming):
+    """A label's file: label_<L>.ply, or the command line's names (cli/LabelsCommand.cpp:
+    <L>_<name>.ply when the volume has label names, '/', '\\' and ' ' made '_')."""
+    if not naming or not naming["names"]:
+        return f"label_{label}.ply"
+    name = naming["names"].get(str(label), f"label{label}")
+    return f"{label}_{name.replace('/', '_').replace(' ', '_').replace(chr(92), '_')}.ply"
+
+
+def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None):
+    """Task: every label of a shard merged; written into `out_dir` (named by _file_name) when it
+    is given (the files only, returned as figures), else the surfaces' fields returned."""
     from . import Surface
     out = {}
     fragments = _shard_fragments(shard)
@@ -155,9 +164,15 @@ def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir):
             out[label] = fields
             continue
         surface = Surface(**fields)
-        surface.write(str(Path(out_dir) / f"label_{label}.ply"))
+        file = _file_name(label, naming)
+        surface.write(str(Path(out_dir) / file), binary=naming["binary"] if naming else True)
+        area = volume = 0.0
+        for c in surface.components:  # summed in the order the command line's table sums them
+            area += c["area"]
+            volume += c["volume"]
         out[label] = {"voxels": fields["voxels"], "vertices": len(surface.vertices),
-                      "triangles": len(surface.faces), "euler": fields["euler"]}
+                      "triangles": len(surface.faces), "euler": fields["euler"],
+                      "boundaries": len(surface.components), "area": area, "volume": volume, "file": file}
     return out
 
 
@@ -212,7 +227,7 @@ def _map_blocks(client, task, source, blocks, args, progress):
 
 
 def _run(source, *, block, spacing, origin, direction, background, adjacency, figures, client, workers,
-         work_dir, out_dir, shards, progress):
+         work_dir, out_dir, shards, progress, naming=None):
     from dask.distributed import as_completed
     from . import _geometry
 
@@ -227,8 +242,8 @@ def _run(source, *, block, spacing, origin, direction, background, adjacency, fi
                               progress)
         plan = client.submit(_plan, futures, shards or max(1, 2 * len(client.scheduler_info()["workers"])), pure=False)
         shard_list = plan.result()
-        reduced = [client.submit(_reduce_shard, s, geometry, background, adjacency, figures, out_dir, pure=False)
-                   for s in shard_list]
+        reduced = [client.submit(_reduce_shard, s, geometry, background, adjacency, figures, out_dir, naming,
+                                 pure=False) for s in shard_list]
         out, merged, total = {}, 0, sum(len(s) for s in shard_list)
         for future in as_completed(reduced):
             part = future.result()

@@ -221,3 +221,73 @@ def test_threshold_bad_input(client):
         blocks.threshold_surface(volume[0], 0.5, client=client)
     with pytest.raises(ValueError, match="adjacency"):
         blocks.threshold_surface(volume, 0.5, adjacency="8-4", client=client)
+
+
+def cli():
+    path = os.environ.get("SURFTRACK_CLI") or str(Path(__file__).resolve().parents[2] / "build" / "cli" / "surftrack")
+    if not os.access(path, os.X_OK):
+        pytest.skip(f"the surftrack CLI is not built at {path}")
+    return path
+
+
+def run_cli(*args):
+    import subprocess
+    return subprocess.run([cli(), *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+def test_cli_labels_on_dask_writes_the_single_pass_files_and_table(tmp_path):
+    """`surftrack labels STORE -o DIR/ --dask local:2` against the CLI's own single pass on the
+    same store: every mesh file byte for byte, labels.csv and --table equal (but for the
+    directory in the file column), with label names ('/' made '_'), a geometry override,
+    an OME-Zarr level and --ascii."""
+    rng = np.random.default_rng(31)
+    shape = (37, 29, 41)
+    seeds = rng.integers(0, shape, size=(15, 3))
+    grid = np.stack(np.indices(shape), axis=-1).reshape(-1, 1, 3)
+    cells = np.argmin(((grid - seeds[None]) ** 2).sum(-1), axis=1).reshape(shape).astype(np.uint16)
+    cells[cells == 4] = 0  # one cell is background
+    store = tmp_path / "seg.ome.zarr"
+    root = zarr.open_group(str(store), mode="w")
+    for level, data in enumerate([cells, cells[::2, ::2, ::2]]):
+        root.create_dataset(f"s{level}", data=data, chunks=(8, 9, 7))
+    root.attrs["multiscales"] = [{"version": "0.4", "axes": [{"name": a, "type": "space", "unit": "micrometer"}
+                                                              for a in "zyx"],
+                                  "datasets": [{"path": f"s{k}", "coordinateTransformations": [
+                                      {"type": "scale", "scale": [2.0 * 2**k, 1.5 * 2**k, 1.0 * 2**k]}]}
+                                      for k in range(2)]}]
+    names = tmp_path / "names.txt"
+    names.write_text("".join(f"{L} region/{L}\n" for L in range(1, 15, 2)))  # ('/' made '_' in file names)
+    for extra in [[], ["--level", 1, "--ascii", "--spacing", "1,2,3", "--adjacency", "6-26"]]:
+        single, dask = tmp_path / f"single{len(extra)}", tmp_path / f"dask{len(extra)}"
+        common = ["--label-names", names, *extra]
+        a = run_cli("labels", store, "-o", f"{single}/", *common, "--table", tmp_path / "a.json")
+        assert a.returncode == 0, a.stderr
+        b = run_cli("labels", store, "-o", f"{dask}/", *common, "--table", tmp_path / "b.json", "--dask", "local:2",
+                    "--block", "16,10,12", "--work-dir", tmp_path / f"work{len(extra)}")
+        assert b.returncode == 0, b.stderr
+        assert "blocks meshed" in b.stderr and "labels merged" in b.stderr
+        files = sorted(p.name for p in single.iterdir())
+        assert files == sorted(p.name for p in dask.iterdir()) and len(files) == 14  # 13 labels + labels.csv
+        assert "1_region_1.ply" in files and "2_label2.ply" in files
+        for f in files:
+            left, right = (single / f).read_bytes(), (dask / f).read_bytes()
+            if f == "labels.csv":
+                left, right = left.replace(str(single).encode(), b"D"), right.replace(str(dask).encode(), b"D")
+            assert left == right, f
+        assert (tmp_path / "a.json").read_text().replace(str(single), "D") == \
+            (tmp_path / "b.json").read_text().replace(str(dask), "D")
+
+
+def test_cli_labels_on_dask_bad_input(tmp_path):
+    zarr.open(str(tmp_path / "s.zarr"), mode="w", shape=(6, 6, 6), chunks=(3, 3, 3), dtype="<u2")[:] = 1
+    (tmp_path / "v.raw").write_bytes(bytes(216))
+    cases = [(["labels", tmp_path / "v.raw", "--raw-dims", "6,6,6", "--raw-type", "uint8", "-o", f"{tmp_path}/a/",
+               "--dask", "local:2"], "chunked store"),
+             (["labels", tmp_path / "s.zarr", "-o", tmp_path / "all.ply", "--dask", "local:2"], "-o DIR/"),
+             (["labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/b/", "--dask", "local:2", "--labels", "1"], "not with"),
+             (["labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/c/", "--block", "4,4,4"], "for --dask"),
+             (["labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/d/", "--dask", "local:0"], "local:N")]
+    for args, says in cases:
+        r = run_cli(*args)
+        assert r.returncode != 0 and says in r.stderr and r.stderr.count("\n") == 1, (args, r.stderr)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr", "v.raw"]  # nothing written, no temporary left
