@@ -1,10 +1,12 @@
 // `surftrack mesh INPUT -o OUTPUT [options]`.
+#include <filesystem>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 
 #include "ChunkedSource.h"
 #include "Commands.h"
+#include "DaskJob.h"
 #include "Extraction.h"
 #include "OutputFile.h"
 #include "Report.h"
@@ -42,6 +44,41 @@ void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progr
 
 }  // namespace
 
+/// `mesh STORE --all --iso S --dask ADDRESS`: every boundary by blocks on Dask, the same file as
+/// the single pass (DaskJob.h); the summary gives the driver's figures.
+static int meshAllOnDask(const MeshOptions& o, bool binary) {
+  ImageGeometry g;
+  nlohmann::json job = storeJob(o.input, o.dask, o.block, o.workDir, g);
+  job["kind"] = "threshold";
+  job["iso"] = *o.surface.iso;
+  job["mapping"] = o.surface.mapping == MappingMode::Midpoint ? "midpoint" : "linear";
+  job["adjacency"] = toString(o.surface.pair);
+  const std::string output = std::filesystem::absolute(o.output).string();
+  job["output"] = output;
+  job["binary"] = binary;
+  job["quiet"] = o.out.quiet;
+  const StageClock clock;
+  const nlohmann::json r = runDaskJob(job, output, "");
+  nlohmann::ordered_json j;
+  j["input"] = o.input.path;
+  j["output"] = o.output;
+  j["dask"] = o.dask;
+  j["vertices"] = r["vertices"];
+  j["triangles"] = r["triangles"];
+  j["boundaries"] = r["boundaries"];
+  j["euler_characteristic"] = r["euler"];
+  j["seconds"] = number(clock.total());
+  if (o.out.json) {
+    std::cout << jsonText(j) << std::endl;
+  } else if (!o.out.quiet) {
+    std::cout << "surftrack: " << o.input.path << " -> " << o.output << " (by blocks on Dask, " << o.dask << ")\n"
+              << "  mesh        " << r["boundaries"] << " boundaries, " << r["vertices"] << " vertices, "
+              << r["triangles"] << " triangles, Euler characteristic " << r["euler"] << "\n"
+              << "  time        " << num(clock.total(), 3) << " s\n";
+  }
+  return 0;
+}
+
 int runMesh(const std::vector<std::string>& args) {
   const MeshOptions o = parseMeshOptions(args);
   Extraction x;
@@ -50,6 +87,7 @@ int runMesh(const std::vector<std::string>& args) {
   x.binary = !o.ascii && (x.format == "ply" || x.format == "stl");
   requireWritable(o.output);        // fail now rather than after the work
   requireNotInput(o.output, o.input.path);
+  if (!o.dask.empty()) return meshAllOnDask(o, x.binary);
 
   Progress progress(Progress::wanted(o.out.quiet));
   StageClock clock;

@@ -23,6 +23,8 @@
 #include <surftrack/ThresholdBlocks.h>
 
 #include "ChunkedSource.h"
+#include <OpenMesh/Core/System/omstream.hh>
+
 #include "ArrayChunkProvider.h"
 #include "ChunkedStore.h"  // io/: zarr, OME-Zarr, N5
 #include "ReadVolume.h"    // io/: ReadError
@@ -826,6 +828,11 @@ void writePrecomputed(const py::list& segments, const std::string& path, std::ar
 
 PYBIND11_MODULE(_surftrack, m) {
   m.doc() = "surftrack's C++ front door (see surftrack.extract)";
+  // OpenMesh's writers log to stderr ("[OBJWriter] : write file"); errors reach Python as
+  // exceptions with their own one-line messages, as in the CLI (cli/main.cpp).
+  omerr().disable();
+  omlog().disable();
+  omout().disable();
   py::register_exception<InvalidInput>(m, "InvalidInput", PyExc_ValueError);
   py::register_exception<InternalError>(m, "InternalError", PyExc_RuntimeError);
   py::register_exception<Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);

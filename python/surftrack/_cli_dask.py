@@ -1,5 +1,6 @@
-"""The Dask side of the command line's ``surftrack labels STORE -o DIR/ --dask ...`` (docs/cli.md,
-"Every label by blocks on Dask"), run by the CLI as ``python3 -m surftrack._cli_dask JOB.json``.
+"""The Dask side of the command line's ``surftrack labels STORE -o DIR/ --dask ...`` and
+``surftrack mesh STORE --all --iso S -o FILE --dask ...`` (docs/cli.md, "Every label by blocks on
+Dask"), run by the CLI as ``python3 -m surftrack._cli_dask JOB.json`` (cli/DaskJob.h).
 
 The CLI checks the options, reads the store's metadata and the label names, and owns the outputs
 (the staging directory, labels.csv, --table, the final rename); this module runs
@@ -58,17 +59,23 @@ def run(job: dict) -> list:
         step = max(1, total // 20)
         if not quiet and (done == total or done - last.get(stage, 0) >= step):
             last[stage] = done
-            what = "blocks meshed" if stage == "blocks" else "labels merged"
-            print(f"surftrack labels: {what} {done} of {total}", file=sys.stderr, flush=True)
+            what = {"blocks": "blocks meshed", "labels": "labels merged", "merge": "merged"}[stage]
+            command = "labels" if job["kind"] == "labels" else "mesh"
+            print(f"surftrack {command}: {what} {done} of {total}", file=sys.stderr, flush=True)
 
     client, cluster = _client(job["dask"])
     try:
         with distributed._work_dir(job["work_dir"]) as work:
-                return distributed._run(source, block=tuple(reversed(job["block"])), spacing=spacing,
-                                    origin=job["origin"], direction=direction, background=int(job["background"]),
-                                    adjacency=job["adjacency"], figures=True, client=client, workers=None,
-                                    work_dir=work, out_dir=job["staging"], shards=None, progress=progress,
-                                    naming={"names": job["names"], "binary": job["binary"]})
+            common = dict(block=tuple(reversed(job["block"])), spacing=spacing, origin=job["origin"],
+                          direction=direction, adjacency=job["adjacency"], client=client, workers=None,
+                          work_dir=work, progress=progress)
+            if job["kind"] == "threshold":
+                return distributed._run_threshold(source, job["iso"], mapping=job["mapping"], epsilon=1e-3,
+                                                  figures=True, out_path=job["output"], binary=job["binary"],
+                                                  **common)
+            return distributed._run(source, background=int(job["background"]), figures=True,
+                                    out_dir=job["staging"], shards=None,
+                                    naming={"names": job["names"], "binary": job["binary"]}, **common)
     finally:
         client.close()
         if cluster is not None:
@@ -83,9 +90,10 @@ def main(argv) -> int:
         with open(job["result"], "w") as out:  # the CLI reports it, as its own errors
             json.dump({"error": str(error).splitlines()[0] if str(error) else type(error).__name__}, out)
         return 1
-    rows = [{"label": str(label), **f} for label, f in sorted(figures.items())]
+    if job["kind"] == "labels":
+        figures = [{"label": str(label), **f} for label, f in sorted(figures.items())]
     with open(job["result"], "w") as out:
-        json.dump(rows, out)
+        json.dump(figures, out)
     return 0
 
 
