@@ -512,21 +512,10 @@ io::ChunkedStore openStore(const std::string& path, int level, std::optional<std
   }
 }
 
-/// numpy's name of a voxel type, native byte order.
+/// numpy's name of a voxel type, native byte order (toString's but for the float types, which
+/// numpy would read as float64 both).
 std::string dtypeName(ScalarType type) {
-  switch (type) {
-    case ScalarType::UInt8: return "uint8";
-    case ScalarType::Int8: return "int8";
-    case ScalarType::UInt16: return "uint16";
-    case ScalarType::Int16: return "int16";
-    case ScalarType::UInt32: return "uint32";
-    case ScalarType::Int32: return "int32";
-    case ScalarType::UInt64: return "uint64";
-    case ScalarType::Int64: return "int64";
-    case ScalarType::Float32: return "float32";
-    case ScalarType::Float64: return "float64";
-  }
-  throw py::value_error("unknown voxel type");
+  return type == ScalarType::Float32 ? "float32" : type == ScalarType::Float64 ? "float64" : toString(type);
 }
 
 /// (shape [z, y, x], dtype name) of a store's chosen array.
