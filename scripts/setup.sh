@@ -20,20 +20,33 @@ packages=(
   python3-dev python3-numpy pybind11-dev   # the Python package (Debian's python3, /usr/bin/python3)
   python3-pytest python3-skimage python3-nibabel python3-meshio  # its tests and examples
   python3-venv python3-pip python3-setuptools  # 'pip install --no-build-isolation .' in a venv
+  python3-pil                    # PNG screenshots read by tests/browser/test_neuroglancer.py
   python3-tifffile               # TIFF stacks (ImageJ, OME-TIFF) written independently for tests/test_tiff_stacks.py
   python3-dask python3-distributed  # surftrack.distributed: every label by blocks on a Dask cluster
   python3-zarr python3-numcodecs # zarr, OME-Zarr and N5 stores written independently for the tests (readers, Dask)
   mricron-data                   # real MRI volumes used by the demo and one test
 )
+# Installed without their recommended packages (for Chromium: printing, desktop and network
+# services, a hundred packages a headless browser does not use).
+lean_packages=(
+  chromium                       # headless Chromium for tests/browser/ (Neuroglancer opening the output); node and npm come with the machine
+)
 
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
+sudo=""
+[[ $(id -u) -eq 0 ]] || sudo="sudo"
+updated=false
+# apt_install [apt-get options...] -- packages...: those not installed yet.
+apt_install() {
+  local options=() missing=() p
+  while [[ $1 != -- ]]; do options+=("$1"); shift; done
+  shift
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  ((${#missing[@]})) || return 0
   echo "setup: installing ${missing[*]}" >&2
-  sudo=""
-  [[ $(id -u) -eq 0 ]] || sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}" >/dev/null
-fi
+  $updated || { $sudo apt-get update -qq; updated=true; }
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${options[@]}" "${missing[@]}" >/dev/null
+}
+apt_install -- "${packages[@]}"
+apt_install --no-install-recommends -- "${lean_packages[@]}"

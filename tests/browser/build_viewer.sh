@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Builds the page that tests/browser/test_neuroglancer.py opens: Neuroglancer from the npm
+# registry (package.json, exact versions, package-lock.json) bundled by Vite into OUT/dist, with
+# the driver's playwright-core in OUT/node_modules. Rebuilt only when one of the files below
+# changes (a hash of them in OUT/stamp): about 20 s the first time (npm ci, then a 3 s build),
+# nothing after.
+#
+#   tests/browser/build_viewer.sh OUT
+#
+# Exits 77 (ctest's SKIP_RETURN_CODE) without node and npm: the browser test is then skipped.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+out=${1:?usage: build_viewer.sh OUT}
+files=(package.json package-lock.json vite.config.js index.html viewer.js open_viewer.mjs)
+
+for tool in node npm; do
+  if ! command -v "$tool" >/dev/null; then
+    echo "build_viewer: SKIPPED: no $tool (Debian's nodejs and npm; scripts/setup.sh installs them)" >&2
+    exit 77
+  fi
+done
+
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+stamp=$(cd "$here" && sha256sum "${files[@]}" | sha256sum | cut -d' ' -f1)
+if [[ -f $out/stamp && $(cat "$out/stamp") == "$stamp" && -f $out/dist/index.html ]]; then
+  echo "build_viewer: $out/dist is up to date"
+  exit 0
+fi
+rm -f "$out/stamp"
+(cd "$here" && cp "${files[@]}" "$out/")
+cd "$out"
+start=$(date +%s)
+# --ignore-scripts: the only install scripts are core-js's banner and msgpackr's optional native
+# addon (msgpackr falls back to JavaScript); nothing the bundle needs.
+npm ci --ignore-scripts --no-audit --no-fund --loglevel=error
+installed=$(date +%s)
+npx --no-install vite build
+echo "build_viewer: npm ci $((installed - start)) s, vite build $(($(date +%s) - installed)) s"
+echo "$stamp" >stamp

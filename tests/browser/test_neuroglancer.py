@@ -1,0 +1,346 @@
+"""surftrack's Neuroglancer output opened in a real browser (docs/cli.md, "Neuroglancer output").
+
+Each case writes an output directory — the AAL atlas by the CLI (`surftrack labels aal.nii.gz -o
+DIR --format precomputed`), a Voronoi label volume by `surftrack.write_precomputed` — serves it
+over HTTP on 127.0.0.1 with CORS, as a user serves theirs, and opens it in Neuroglancer (the npm
+package, bundled by build_viewer.sh and served from another origin, as Neuroglancer's own site
+would be) in headless Chromium with software WebGL (open_viewer.mjs), with a state whose
+segmentation layer lists a few segments, each in a colour of its own, in the 3-D layout. It
+checks that:
+  - the viewer gets ready (every chunk of every visible layer loaded and drawn);
+  - nothing went wrong: no console error, no uncaught exception, no failed request, no error
+    in the layer's messages or Neuroglancer's status box;
+  - the data server was asked for every listed segment's manifest and each of its fragments
+    (and answered 200), read from the files written;
+  - the picture shows each segment: the screenshot of the 3-D panel against the same state with
+    no segment selected differs in a good fraction of pixels, and each segment's colour (its hue,
+    which the shading keeps) covers part of the panel.
+A case lists one or more views (state changes, such as a zoom that makes Neuroglancer change
+levels of detail) and, for each, the requests it must cause.
+
+Skipped, with the reason, when node, the bundle (build_viewer.sh), Chromium, the CLI or the AAL
+atlas (mricron-data) is missing. Run by ctest (python/CMakeLists.txt) after the bundle is built.
+"""
+import colorsys
+import dataclasses
+import functools
+import http.server
+import json
+import os
+import shutil
+import subprocess
+import threading
+import time
+import typing
+import urllib.parse
+
+import numpy as np
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+BUNDLE = os.environ.get("SURFTRACK_NEUROGLANCER_BUNDLE", "")  # build_viewer.sh's OUT
+CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
+EXE = os.environ.get("SURFTRACK_CLI", "")
+AAL = "/usr/share/mricron/templates/aal.nii.gz"
+
+
+def missing():
+    """Why the test cannot run here, or None."""
+    if shutil.which("node") is None:
+        return "no node (Debian's nodejs; scripts/setup.sh installs it)"
+    if not os.path.isfile(os.path.join(BUNDLE, "dist", "index.html")):
+        return f"no Neuroglancer bundle in '{BUNDLE}' (tests/browser/build_viewer.sh builds it)"
+    if not os.access(CHROMIUM, os.X_OK):
+        return f"no Chromium at {CHROMIUM} (Debian's chromium; scripts/setup.sh installs it)"
+    if not os.access(EXE, os.X_OK):
+        return "no surftrack CLI (SURFTRACK_CLI)"
+    if not os.path.isfile(AAL):
+        return f"no {AAL} (Debian's mricron-data; scripts/setup.sh installs it)"
+    return None
+
+
+pytestmark = pytest.mark.skipif(missing() is not None, reason=f"browser test SKIPPED: {missing()}")
+
+
+# --- HTTP ---------------------------------------------------------------------------------------
+
+class Handler(http.server.SimpleHTTPRequestHandler):
+    """Static files, with CORS (the viewer runs on another origin) and single byte ranges
+    (Neuroglancer reads parts of files in the multi-resolution format); records each request's
+    path and status."""
+
+    def __init__(self, *args, log, **kwargs):
+        self.log = log
+        super().__init__(*args, **kwargs)
+
+    def end_headers(self):
+        self.send_header("Access-Control-Allow-Origin", "*")
+        self.send_header("Access-Control-Expose-Headers", "Content-Range, Content-Length")
+        self.send_header("Cache-Control", "no-store")
+        super().end_headers()
+
+    def send_head(self):
+        spec = self.headers.get("Range")
+        if spec is None or not spec.startswith("bytes=") or "," in spec:
+            return super().send_head()
+        path = self.translate_path(self.path)
+        if not os.path.isfile(path):
+            return super().send_head()
+        size = os.path.getsize(path)
+        first, _, last = spec[6:].partition("-")
+        if first == "":  # the last N bytes
+            first, last = max(0, size - int(last)), size - 1
+        else:
+            first, last = int(first), min(size - 1, int(last)) if last else size - 1
+        if first > last or first >= size:
+            self.send_error(416)
+            return None
+        f = open(path, "rb")
+        f.seek(first)
+        self.send_response(206)
+        self.send_header("Content-Type", self.guess_type(path))
+        self.send_header("Content-Range", f"bytes {first}-{last}/{size}")
+        self.send_header("Content-Length", str(last - first + 1))
+        self.end_headers()
+        self.range_left = last - first + 1
+        return f
+
+    def copyfile(self, source, outputfile):
+        left = getattr(self, "range_left", None)
+        if left is None:
+            return super().copyfile(source, outputfile)
+        outputfile.write(source.read(left))
+
+    def log_request(self, code="-", size="-"):
+        path = urllib.parse.unquote(urllib.parse.urlsplit(self.path).path)
+        self.log.append((time.time() * 1000, path, int(code)))
+
+    def log_message(self, *args):
+        pass
+
+
+class Server:
+    """A directory served on 127.0.0.1 (a free port) from a thread, while in a `with`."""
+
+    def __init__(self, directory):
+        self.log = []
+        handler = functools.partial(Handler, directory=str(directory), log=self.log)
+        self.httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+        self.url = f"http://127.0.0.1:{self.httpd.server_address[1]}"
+
+    def __enter__(self):
+        self.thread = threading.Thread(target=self.httpd.serve_forever, daemon=True)
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.httpd.shutdown()
+        self.httpd.server_close()
+        self.thread.join()
+
+
+# --- the outputs --------------------------------------------------------------------------------
+
+def write_aal(directory):
+    """The AAL atlas (116 regions on a 181 x 217 x 181 grid of 1 mm voxels), by the CLI."""
+    out = os.path.join(directory, "aal")
+    run = subprocess.run([EXE, "labels", AAL, "-o", out, "--format", "precomputed"],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    return out
+
+
+VORONOI = dict(n=96, cells=50, seed=20261203, spacing=(16.0, 8.0, 8.0))  # [z, y, x] nm
+
+
+def voronoi_volume():
+    """A Voronoi label volume indexed [z, y, x]: each voxel labelled 1 + its nearest centre's
+    index (bench/bench_labels.py makes the large ones the same way), and the centres."""
+    from scipy.spatial import cKDTree
+    n, cells = VORONOI["n"], VORONOI["cells"]
+    centres = np.random.default_rng(VORONOI["seed"]).random((cells, 3)) * n
+    grid = np.stack(np.meshgrid(*(np.arange(n),) * 3, indexing="ij"), axis=-1).reshape(-1, 3)
+    _, nearest = cKDTree(centres).query(grid)
+    return (nearest + 1).astype(np.uint32).reshape(n, n, n), centres
+
+
+def write_voronoi(directory):
+    import surftrack
+    labels, _ = voronoi_volume()
+    spacing = VORONOI["spacing"]
+    surfaces = surftrack.label_surfaces(labels, spacing=spacing)
+    out = os.path.join(directory, "voronoi")
+    surftrack.write_precomputed(surfaces, out, axes="zyx", unit="nm", spacing=spacing)
+    return out
+
+
+def voronoi_segments(count=6):
+    """Cells whose centres lie far apart across the x-y plane (farthest points, greedily), so
+    that seen along z none hides another."""
+    _, centres = voronoi_volume()
+    xy = centres[:, [2, 1]]
+    chosen = [int(np.argmin(np.linalg.norm(xy - VORONOI["n"] / 2, axis=1)))]
+    while len(chosen) < count:
+        d = np.min(np.linalg.norm(xy[:, None] - xy[chosen][None], axis=2), axis=1)
+        chosen.append(int(np.argmax(d)))
+    return [c + 1 for c in chosen]
+
+
+def legacy_requests(out, segments, view):
+    """The legacy format's requests for `segments`: each manifest and the fragments it lists."""
+    paths = set()
+    for s in segments:
+        paths.add(f"{s}:0")
+        with open(os.path.join(out, f"{s}:0")) as f:
+            paths.update(json.load(f)["fragments"])
+    return paths
+
+
+def legacy_vertices(out, segment):
+    """The vertices (x, y, z nm) of a legacy segment, read from its fragments."""
+    with open(os.path.join(out, f"{segment}:0")) as f:
+        fragments = json.load(f)["fragments"]
+    parts = []
+    for name in fragments:
+        data = np.fromfile(os.path.join(out, name), dtype=np.uint8)
+        n = int(data[:4].view("<u4")[0])
+        parts.append(data[4:4 + 12 * n].view("<f4").reshape(n, 3))
+    return np.concatenate(parts)
+
+
+@dataclasses.dataclass
+class Case:
+    name: str
+    write: typing.Callable  # (directory) -> the output directory
+    segments: typing.Callable  # () -> segment ids
+    vertices: typing.Callable = legacy_vertices  # (out, segment) -> (N, 3) nm, for the camera
+    # (out, segments, view) -> the paths under `out` the view must request
+    requests: typing.Callable = legacy_requests
+    views: list = dataclasses.field(default_factory=lambda: [{}])  # state changes, one per view
+
+
+# AAL regions on the brain's upper surface, which a view from above shows side by side:
+# Precentral_L/R, Frontal_Sup_L/R, Parietal_Sup_L/R (aal.nii.txt).
+AAL_SEGMENTS = [1, 2, 3, 4, 59, 60]
+
+CASES = [
+    Case("aal", write_aal, lambda: AAL_SEGMENTS),
+    Case("voronoi", write_voronoi, voronoi_segments),
+]
+
+
+# --- the state and the picture ------------------------------------------------------------------
+
+HUES = [0, 60, 120, 180, 240, 300]  # degrees: red, yellow, green, cyan, blue, magenta
+
+
+def colour(i):
+    r, g, b = colorsys.hsv_to_rgb(HUES[i % len(HUES)] / 360, 1, 1)
+    return "#%02x%02x%02x" % (round(255 * r), round(255 * g), round(255 * b))
+
+
+def state(source, segments, vertices, view):
+    """A Neuroglancer state: one segmentation layer from `source` showing `segments` in the 3-D
+    layout, the camera on their bounding box, seen from +z; nothing else drawn."""
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    s = {
+        "dimensions": {a: [1e-9, "m"] for a in "xyz"},
+        "position": [float(v) for v in (low + high) / 2],
+        "projectionScale": float(1.3 * np.max(high - low)),
+        "projectionOrientation": [0, 0, 0, 1],
+        "layers": [{
+            "type": "segmentation",
+            "name": "surftrack",
+            "source": source,
+            "segments": [str(s) for s in segments],
+            "segmentColors": {str(s): colour(i) for i, s in enumerate(segments)},
+        }],
+        "layout": "3d",
+        "showAxisLines": False,
+        "showDefaultAnnotations": False,
+        "showScaleBar": False,
+        "selectedLayer": {"visible": False},
+    }
+    s.update(view)
+    return s
+
+
+def viewer_url(base, s):
+    return base + "/index.html#!" + urllib.parse.quote(json.dumps(s, separators=(",", ":")))
+
+
+def open_pages(jobs, directory):
+    """Runs open_viewer.mjs on [(url, screenshot path)]: its results, one per page."""
+    path = os.path.join(directory, "jobs.json")
+    with open(path, "w") as f:
+        json.dump([{"url": u, "screenshot": str(p)} for u, p in jobs], f)
+    driver = os.path.join(BUNDLE, "open_viewer.mjs")  # build_viewer.sh's copy, beside node_modules
+    run = subprocess.run(["node", driver, path], capture_output=True, text=True,
+                         env=dict(os.environ, CHROMIUM=CHROMIUM), timeout=60 + 35 * len(jobs))
+    assert run.returncode == 0, run.stderr
+    return json.loads(run.stdout.strip().splitlines()[-1])
+
+
+def pixels(path):
+    from PIL import Image
+    with Image.open(path) as image:
+        return np.asarray(image.convert("RGB")).astype(np.int16)
+
+
+def hue_coverage(rgb, count):
+    """The fraction of pixels of each of the first `count` hues (saturated, not dark)."""
+    hsv = np.asarray([colorsys.rgb_to_hsv(*p) for p in rgb.reshape(-1, 3) / 255.0])
+    lit = (hsv[:, 1] > 0.5) & (hsv[:, 2] > 0.15)
+    hue = hsv[:, 0] * 360
+    out = []
+    for i in range(count):
+        d = np.abs((hue - HUES[i] + 180) % 360 - 180)
+        out.append(float(np.mean(lit & (d < 15))))
+    return out
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
+def test_neuroglancer_shows_the_segments(case, tmp_path):
+    data = tmp_path / "data"
+    data.mkdir()
+    out = case.write(data)
+    segments = case.segments()
+    name = os.path.relpath(out, data)
+    vertices = np.concatenate([case.vertices(out, s) for s in segments])
+    with Server(os.path.join(BUNDLE, "dist")) as page, Server(data) as files:
+        source = f"precomputed://{files.url}/{name}"
+        blank = state(source, [], vertices, case.views[0])
+        jobs = [(viewer_url(page.url, blank), tmp_path / "none.png")]
+        for i, view in enumerate(case.views):
+            jobs.append((viewer_url(page.url, state(source, segments, vertices, view)),
+                         tmp_path / f"view{i}.png"))
+        results = open_pages(jobs, tmp_path)
+        # Each page's requests: those the server logged while it was open (one at a time).
+        logs = [[(p, status) for t, p, status in files.log if r["startedAt"] <= t <= r["endedAt"]]
+                for r in results]
+    for (url, shot), result, log in zip(jobs, results, logs):
+        print(f"{case.name}: {shot.name} ready in {result['seconds']} s on {result['renderer']}; "
+              f"{len(log)} requests")
+        for m in result["console"]:
+            print(f"  console {m['type']}: {m['text']}")
+        assert result["ready"], f"{shot.name}: the viewer did not get ready: {result}"
+        assert not result["pageErrors"], result["pageErrors"]
+        assert not result["failedRequests"], result["failedRequests"]
+        assert not result["statusErrors"], result["statusErrors"]
+        errors = [m["text"] for m in result["console"] if m["type"] == "error"]
+        assert not errors, f"{shot.name}: console errors: {errors}"
+        assert all(status == 200 or status == 206 for _, status in log), log
+    background = pixels(jobs[0][1])
+    for i, view in enumerate(case.views):
+        asked = {p[len(name) + 2:] for p, _ in logs[i + 1] if p.startswith(f"/{name}/")}
+        wanted = case.requests(out, segments, view)
+        assert wanted <= asked, f"view {i}: not requested: {sorted(wanted - asked)}"
+        shot = pixels(jobs[i + 1][1])
+        assert shot.shape == background.shape
+        changed = float(np.mean(np.any(np.abs(shot - background) > 24, axis=2)))
+        coverage = hue_coverage(shot, len(segments))
+        print(f"  view {i}: {changed:.1%} of the pixels changed; each segment's colour covers "
+              + ", ".join(f"{c:.2%}" for c in coverage))
+        assert changed > 0.05, f"view {i}: the 3-D panel looks blank ({changed:.2%} changed)"
+        for s, c in zip(segments, coverage):
+            assert c > 0.002, f"view {i}: segment {s} is not seen ({c:.3%} of the pixels)"
