@@ -38,6 +38,10 @@ const browser = await chromium.launch({
     "--no-sandbox",  // CI runs as root
   ],
 });
+// A console message that reports an error: console.error, or a message saying "error" (the
+// chunk workers report a chunk that fails to load or decode with console.log).
+const isError = (m) => m.type === "error" || /\berror\b/i.test(m.text);
+
 async function open({ url, screenshot }) {
   const result = {
     url,
@@ -62,10 +66,24 @@ async function open({ url, screenshot }) {
     const start = Date.now();
     await page.goto(url, { waitUntil: "load", timeout });
     await page.waitForFunction(() => window.viewer !== undefined, null, { timeout });
+    // Ready, or failed: a page that reports an error is given `settle` ms more (for the
+    // messages that follow) and then left, rather than waited on until the timeout.
     let readySince = null;
+    let failedSince = null;
     while (Date.now() - start < timeout) {
       const ready = await page.evaluate(() => window.viewer.isReady());
       const now = Date.now();
+      const failed =
+        result.pageErrors.length > 0 ||
+        result.failedRequests.length > 0 ||
+        result.console.some(isError) ||
+        (await page.evaluate(() =>
+          window.viewer.layerManager.managedLayers.some((managed) =>
+            managed.layer?.dataSources.some((source) => source.loadState?.error !== undefined),
+          ),
+        ));
+      if (failed && failedSince === null) failedSince = now;
+      if (failedSince !== null && now - failedSince >= settle) break;
       if (!ready) readySince = null;
       else if (readySince === null) readySince = now;
       else if (now - readySince >= settle) {
