@@ -3,7 +3,8 @@
 # registry (package.json, exact versions, package-lock.json) bundled by Vite into OUT/dist, with
 # the driver's playwright-core in OUT/node_modules. Rebuilt only when one of the files below
 # changes (a hash of them in OUT/stamp), the packages reinstalled only when package.json or
-# package-lock.json changes: about 20 s the first time (npm ci, then a 3 s build), nothing after.
+# package-lock.json changes: 15-22 s for npm ci the first time, then a 3 s build (24-38 s on the
+# 2-core machine while others compile), nothing after.
 #
 #   tests/browser/build_viewer.sh OUT
 #
