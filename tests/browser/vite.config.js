@@ -1,5 +1,6 @@
 // The bundle for the browser test: Neuroglancer's npm package (ES modules meant for a bundler)
-// with only the precomputed data source, served as static files from dist/.
+// with only the precomputed data source, served as static files from dist/. Vite 7 rather than
+// 8: Vite 8 fails to install where a machine's npm is still version 10.
 import { existsSync } from "node:fs";
 import { createRequire } from "node:module";
 import { dirname, join } from "node:path";
