@@ -43,6 +43,8 @@ constexpr std::size_t kMaxDecoded = (std::size_t(1) << 20) - 1;    // codec inpu
 
 [[noreturn]] void finding(const std::string& what) { throw FuzzFinding{what}; }
 
+bool gValid = false;  // the input is a valid store or chunk: a ReadError is a finding
+
 /// `text` with its control bytes escaped, for a finding's message.
 std::string printable(std::string_view text) {
   std::string s;
@@ -80,6 +82,7 @@ bool readOrRefuse(const char* where, F&& f) {
     return true;
   } catch (const io::ReadError& e) {
     requireOneLine(e, where);
+    if (gValid) finding(std::string(where) + " refuses a valid input: " + printable(e.what()));
     return false;
   } catch (const FuzzFinding&) {
     throw;
@@ -257,6 +260,7 @@ void runStore(std::string_view format, std::string_view input, const fs::path& s
     cache = std::make_shared<const ChunkCache>(opened.provider, std::size_t(1) << 20);
   } catch (const InvalidInput& e) {  // dimensions beyond the surfel keys' 20 bits
     requireOneLine(e, "ChunkCache");
+    if (gValid) finding(std::string("ChunkCache refuses a valid store: ") + printable(e.what()));
     return;
   } catch (const std::exception& e) {
     finding("ChunkCache threw " + typeName(e) + ": " + printable(e.what()));
@@ -362,7 +366,8 @@ bool isChunkedFuzzFormat(std::string_view format) {
   return false;
 }
 
-void runChunkedFuzzInput(std::string_view format, std::string_view input, const fs::path& scratch) {
+void runChunkedFuzzInput(std::string_view format, std::string_view input, const fs::path& scratch, bool valid) {
+  gValid = valid;
   if (format == "zarr" || format == "n5" || format == "omezarr")
     runStore(format, input, scratch);
   else if (isChunkedFuzzFormat(format))

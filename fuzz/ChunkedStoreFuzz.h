@@ -37,7 +37,9 @@ bool isChunkedFuzzFormat(std::string_view format);
 inline constexpr std::string_view kFileMarker = "\n@@@@ ";
 
 /// Runs one input of `format` (the store written in `scratch`, emptied first). Throws
-/// FuzzFinding; the readers' ReadErrors (one line) and the cache's InvalidInput are expected.
-void runChunkedFuzzInput(std::string_view format, std::string_view input, const std::filesystem::path& scratch);
+/// FuzzFinding; the readers' ReadErrors (one line) and the cache's InvalidInput are expected,
+/// unless the input is `valid` (a seed): then it must be read whole.
+void runChunkedFuzzInput(std::string_view format, std::string_view input, const std::filesystem::path& scratch,
+                         bool valid = false);
 
 }  // namespace surftrack::fuzz

@@ -76,7 +76,8 @@ for f in "${formats[@]}"; do
   mkdir -p "$run/corpus" "$run/findings"
   # The kept findings, each run once.
   kept=("$here/findings/$f"/*)
-  if [[ -e ${kept[0]} ]] &&
+  [[ -e ${kept[0]} ]] || kept=()
+  if [[ ${#kept[@]} -gt 0 ]] &&
      ! "$target" "${kept[@]}" "${limits[@]}" -artifact_prefix="$run/findings/" </dev/null >"$run/replay.log" 2>&1; then
     echo "run_fuzzers: $f: a kept finding fails again (fuzz/findings/$f/):"
     grep -m3 -E "Running:|ERROR|SUMMARY|fuzz_[a-z_]* \(" "$run/replay.log" || tail -5 "$run/replay.log"
