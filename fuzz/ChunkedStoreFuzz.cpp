@@ -2,7 +2,7 @@
 // user's tool reads it: recognised (isChunkedStore), opened (openChunkedStore), every chunk
 // decoded by the provider (a sample when there are many), then read again through the core's
 // ChunkCache and chunked VoxelSource, whose gray values must be the provider's. Arrays whose
-// chunks decode to more than 16 MiB are opened but not read: the readers accept chunks of up to
+// chunks decode to more than 4 MiB are opened but not read: the readers accept chunks of up to
 // 2 GiB (io/ChunkGrid.h), which a fuzzer's memory limit cannot hold.
 #include "ChunkedStoreFuzz.h"
 
@@ -36,8 +36,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::uint64_t kMaxChunkBytes = std::uint64_t(16) << 20;  // a decoded chunk read, whole
-constexpr std::uint64_t kMaxBytesRead = std::uint64_t(32) << 20;   // all the chunks of one input
+constexpr std::uint64_t kMaxChunkBytes = std::uint64_t(4) << 20;   // a decoded chunk read, whole
+constexpr std::uint64_t kMaxBytesRead = std::uint64_t(8) << 20;    // all the chunks of one input
 constexpr std::uint64_t kMaxChunks = 256;                          // chunks read per input
 constexpr std::size_t kMaxDecoded = (std::size_t(1) << 20) - 1;    // codec inputs: decoded sizes
 
