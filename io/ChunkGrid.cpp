@@ -57,7 +57,7 @@ void copyVoxels(const unsigned char* src, std::size_t stride, unsigned char* dst
 std::string escapedText(const std::string& text) {
   // A name read from metadata (an OME-Zarr level's path, an axis name or type, a codec's id)
   // may hold any character; messages are one line (docs/api.md, "Chunked stores"), so control
-  // bytes are written as escapes (two-line messages found by fuzz/fuzz_chunked_store.cpp).
+  // bytes are written as escapes (two-line messages: fuzz/findings/).
   std::string s;
   for (const char c : text) {
     const auto u = static_cast<unsigned char>(c);

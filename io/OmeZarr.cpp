@@ -121,8 +121,8 @@ OmeMultiscale readOmeMultiscale(const std::string& dir) {
       throw ReadError(context + ": " + where + " has no coordinateTransformations (OME-Zarr 0.4 requires a scale)");
     compose(d["coordinateTransformations"], rank, scale, translation, context, where);
     compose(global, rank, scale, translation, context, "the multiscale");
-    // Each factor is finite and positive, their product need not be (1e200 twice: found by
-    // fuzz/fuzz_chunked_store.cpp); the engine places voxels with it.
+    // Each factor is finite and positive, their product need not be (1e200 twice:
+    // fuzz/findings/omezarr/); the engine places voxels with it.
     for (int a = 0; a < rank; ++a)
       if (!(std::isfinite(scale[a]) && scale[a] > 0 && std::isfinite(translation[a])))
         throw ReadError(context + ": the coordinateTransformations of " + where + " and the multiscale give axis " +
