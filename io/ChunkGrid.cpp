@@ -54,7 +54,24 @@ void copyVoxels(const unsigned char* src, std::size_t stride, unsigned char* dst
 
 }  // namespace
 
-std::string quotedPath(const std::string& path) { return "'" + path + "'"; }
+std::string escapedText(const std::string& text) {
+  // A name read from metadata (an OME-Zarr level's path, an axis name or type, a codec's id)
+  // may hold any character; messages are one line (docs/api.md, "Chunked stores"), so control
+  // bytes are written as escapes (two-line messages: fuzz/findings/).
+  std::string s;
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u != 0x7f) {
+      s += c;
+    } else {
+      static constexpr char kHex[] = "0123456789abcdef";
+      s += c == '\n' ? "\\n" : c == '\t' ? "\\t" : std::string("\\x") + kHex[u >> 4] + kHex[u & 15];
+    }
+  }
+  return s;
+}
+
+std::string quotedPath(const std::string& path) { return "'" + escapedText(path) + "'"; }
 
 std::uint64_t chunkBytes(const ChunkGrid& grid) {
   std::uint64_t bytes = sizeOf(grid.type);

@@ -19,7 +19,10 @@
 
 namespace surftrack::io::detail {
 
-/// "'path'", for messages.
+/// `text` with its control bytes escaped (\n, \x01), for messages of one line.
+std::string escapedText(const std::string& text);
+
+/// "'path'", for messages: a path or a name read from metadata, quoted, escaped.
 std::string quotedPath(const std::string& path);
 
 /// An N-dimensional chunked array, in numpy's axis order, and the 3D volume the engine reads.

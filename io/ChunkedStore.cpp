@@ -56,8 +56,8 @@ std::vector<std::int64_t> chooseLeading(const std::vector<std::string>& names, c
     if (kinds[a] == "channel" && options.channel) index = *options.channel, usedChannel = true;
     if (kinds[a] == "time" && options.time) index = *options.time, usedTime = true;
     if (index < 0 || index >= shape[a])
-      throw ReadError("cannot read " + quotedPath(path) + ": " + kinds[a] + " " + std::to_string(index) + " is outside its axis '" +
-                      names[a] + "' of " + std::to_string(shape[a]) + " (0 to " + std::to_string(shape[a] - 1) + ")");
+      throw ReadError("cannot read " + quotedPath(path) + ": " + detail::escapedText(kinds[a]) + " " + std::to_string(index) + " is outside its axis " +
+                      quotedPath(names[a]) + " of " + std::to_string(shape[a]) + " (0 to " + std::to_string(shape[a] - 1) + ")");
     fixed.push_back(index);
     chosen.push_back({names[a], kinds[a], index, shape[a]});
   }

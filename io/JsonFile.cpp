@@ -20,7 +20,16 @@ std::optional<nlohmann::json> readJsonFile(const std::string& path) {
   }
   if (!text) return std::nullopt;
   try {
-    return nlohmann::json::parse(*text);
+    // nlohmann-json parses without recursion but copies and prints values recursively: a
+    // document of a few ten thousand nested lists overflowed the stack when a reader copied or
+    // quoted one (fuzz/findings/zarr/). Metadata nests a few levels (OME-Zarr's transformations
+    // sit at depth 6); deeper than kMaxDepth is refused while parsing.
+    constexpr int kMaxDepth = 100;
+    return nlohmann::json::parse(*text, [&](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+      if (depth > kMaxDepth)
+        throw ReadError("cannot read " + quotedPath(path) + ": JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
+      return true;
+    });
   } catch (const nlohmann::json::exception& e) {
     // The library's message may quote the text read: one line kept.
     std::string why = e.what();

@@ -52,7 +52,7 @@ ChunkCodec parseCompression(const json& m, const std::string& context) {
     codec.description = "blosc (" + (c.contains("cname") ? c["cname"].dump() : std::string("?")) + ", shuffle " +
                         (c.contains("shuffle") ? c["shuffle"].dump() : std::string("?")) + ")";
   } else {
-    throw ReadError(context + ": unsupported compression " + (type.empty() ? jsonText(c) : "'" + type + "'") +
+    throw ReadError(context + ": unsupported compression " + (type.empty() ? jsonText(c) : quotedPath(type)) +
                     ": surftrack reads raw, gzip, zstd or blosc");
   }
   return codec;

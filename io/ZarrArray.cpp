@@ -114,7 +114,7 @@ ChunkCodec parseCompressor(const json& value, const std::string& context) {
     codec.kind = id == "zstd" ? ChunkCodec::Kind::Zstd : id == "zlib" ? ChunkCodec::Kind::Zlib : ChunkCodec::Kind::Gzip;
     codec.description = id;
   } else {
-    throw ReadError(context + ": unsupported compressor " + (id.empty() ? jsonText(value) : "'" + id + "'") +
+    throw ReadError(context + ": unsupported compressor " + (id.empty() ? jsonText(value) : quotedPath(id)) +
                     ": surftrack reads blosc, zstd, zlib, gzip or none");
   }
   return codec;

@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # The checks beyond the README's test command:
-#   fuzz [seconds]  the libFuzzer target of fuzz/ (the header readers that locate voxel data),
-#                   run per format for a bounded time, seeded with the test files
-#                   (fuzz/run_fuzzers.sh; default 10 s per format; with SURFTRACK_FUZZ_RUNS=N,
-#                   N inputs from a fixed seed instead). CI runs this with N = 5000 (.ci/run).
+#   fuzz [seconds]  the libFuzzer targets of fuzz/: the header readers that locate voxel data
+#                   (8 formats) and the chunked-store readers (zarr, N5 and OME-Zarr stores,
+#                   metadata and chunk files; the blosc, zstd and gzip/zlib chunk decoders), run
+#                   per format for a bounded time, seeded with files written by ITK, zarr-python
+#                   and numcodecs (fuzz/run_fuzzers.sh; default 10 s per format; with
+#                   SURFTRACK_FUZZ_RUNS=N, N inputs from a fixed seed instead). CI runs this
+#                   with N = 5000 (.ci/run).
 #   sanitize        the whole test suite again, in a build of its own with AddressSanitizer and
 #                   UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its
 #                   test). CI runs it last (.ci/run). Measured in CPU time (the 2-core machines
