@@ -152,8 +152,12 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   options.boundaries = o.largest ? LabelBoundaries::Largest : LabelBoundaries::All;
   options.seeds = o.seeds;
   options.pair = o.pair;
+  options.walls = o.walls == "shared" ? LabelWalls::Shared : LabelWalls::Independent;
   options.threads = o.threads;
   const std::vector<LabelSurface> surfaces = extractLabels(view, options);
+  if (!o.out.quiet)
+    for (const LabelSurface& l : surfaces)
+      for (const std::string& w : l.surface.warnings) std::cerr << "surftrack: warning: " << w << "\n";
   clock.lap(timings, "extract");
 
   // The rows, and the file of each label.
@@ -224,6 +228,7 @@ int runLabels(const std::vector<std::string>& args) {
     j["output"] = o.output;
     j["names"] = namesFile;
     j["adjacency"] = toString(o.pair);
+    j["walls"] = o.walls;
     j["labels"] = labelTableJson(rows);
     nlohmann::ordered_json t = nlohmann::ordered_json::object();
     for (const StageTiming& s : run.timings) t[s.name] = number(s.seconds);

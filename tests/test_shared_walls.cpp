@@ -1,0 +1,434 @@
+// Shared walls of label maps (LabelWalls::Shared; docs/theory.md, "Shared walls") against
+// computations that do not use them:
+//  - every 2 x 2 x 2 cube of up to 8 labels in every priority order (all 545,835 ordered set
+//    partitions of the corners), for the four pairs: each wall separates two labels and is a
+//    supporting plane of the level sets it bounds (the hull property of Definition 9, checked by
+//    plane sides); each label's triangles close up inside the cube; each face's trace is a
+//    function of the face's four corners alone and the two cubes of a face see it reversed;
+//  - 1,000 random label images of 2 to 40 labels (dense random labels, fixed seeds): every wall
+//    triangle of a label has exactly one reversed twin in another label (or lies on the domain's
+//    border), at bit-identical coordinates; the walls between priorities >= t and < t are
+//    exactly the binary surface of the voxels of priority >= t made by the independent path;
+//    voxel centres and random points lie inside exactly one label or the background (winding
+//    numbers); every label's mesh is a closed oriented 2-manifold, with vertices at equal points
+//    exactly at its counted pinch copies.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "CaseSubset.h"
+#include "ClosedManifold.h"
+#include "DigitalCube.h"
+#include "Labels.h"
+#include "MeshChecks.h"
+#include "NestedWalls.h"
+#include "PairTestName.h"
+
+namespace surftrack {
+namespace {
+
+using testing::caseChecked;
+using Ranks = std::array<std::uint8_t, 8>;
+
+/// Every map of the 8 corners onto 0..k-1 (k = 1..8): set partitions by restricted growth
+/// strings, then every order of their parts.
+std::vector<Ranks> allPriorityPatterns() {
+  std::vector<Ranks> out;
+  std::array<int, 8> block{};
+  auto emit = [&](int parts) {
+    std::vector<std::uint8_t> order(std::size_t(parts));
+    std::iota(order.begin(), order.end(), std::uint8_t(0));
+    do {
+      Ranks r;
+      for (int i = 0; i < 8; ++i) r[std::size_t(i)] = order[std::size_t(block[std::size_t(i)])];
+      out.push_back(r);
+    } while (std::next_permutation(order.begin(), order.end()));
+  };
+  auto grow = [&](auto&& self, int i, int parts) -> void {
+    if (i == 8) return emit(parts);
+    for (int b = 0; b <= parts && b < 8; ++b) {
+      block[std::size_t(i)] = b;
+      self(self, i + 1, std::max(parts, b + 1));
+    }
+  };
+  grow(grow, 0, 0);
+  return out;
+}
+
+std::array<int, 3> doubledMidpoint(int edge) {
+  const Voxel a = cube::cornerOffset(cube::edgeLowCorner(edge)), b = cube::cornerOffset(cube::edgeHighCorner(edge));
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+
+class SharedWallCubes : public ::testing::TestWithParam<AdjacencyPair> {};
+
+TEST_P(SharedWallCubes, EveryPriorityPatternOfACube) {
+  const AdjacencyPair pair = GetParam();
+  const std::vector<Ranks> patterns = allPriorityPatterns();
+  ASSERT_EQ(patterns.size(), 545835u);  // the ordered Bell (Fubini) number of 8
+  // Face traces: key (the face's dense ranks, its side) -> directed segments per label, as face
+  // edge pairs; face edge j of the face normal to axis a: the cube edge parallel to the other
+  // axis u or v, in the face's own numbering.
+  std::map<std::pair<std::uint32_t, int>, std::vector<std::array<int, 3>>> traces;
+  std::size_t checked = 0, foreignPatterns = 0, threeOrMore = 0, maxTriangles = 0;
+  for (std::size_t c = 0; c < patterns.size(); ++c) {
+    if (!caseChecked(c)) continue;
+    ++checked;
+    const Ranks& rank = patterns[c];
+    const int levels = *std::max_element(rank.begin(), rank.end()) + 1;
+    if (levels >= 3) ++threeOrMore;
+    const CubeWalls walls = cubeWalls(rank, pair);
+    maxTriangles = std::max(maxTriangles, std::size_t(walls.count));
+    // Each label's triangles: the walls it is inside of, and those it is outside of, reversed.
+    std::vector<std::vector<std::array<int, 3>>> label(std::size_t(levels));
+    std::set<std::array<int, 3>> distinct;
+    bool foreign = false;
+    for (int w = 0; w < walls.count; ++w) {
+      const WallTriangle& t = walls.triangles[std::size_t(w)];
+      ASSERT_GT(t.inside, t.outside) << "pattern " << c;
+      ASSERT_LT(int(t.inside), levels);
+      std::array<int, 3> sorted{t.edges[0], t.edges[1], t.edges[2]};
+      std::sort(sorted.begin(), sorted.end());
+      ASSERT_TRUE(distinct.insert(sorted).second) << "a wall twice, pattern " << c;
+      // Each vertex's cube edge is cut at every level the wall bounds: one end >= inside, one
+      // <= outside.
+      for (int k : t.edges) {
+        const int a = rank[std::size_t(cube::edgeLowCorner(k))], b = rank[std::size_t(cube::edgeHighCorner(k))];
+        ASSERT_GE(std::max(a, b), int(t.inside)) << "pattern " << c;
+        ASSERT_LE(std::min(a, b), int(t.outside)) << "pattern " << c;
+        if (a != t.inside && b != t.inside) foreign = true;
+        if (a != t.outside && b != t.outside) foreign = true;
+      }
+      // The hull property (Definition 9): for kappa = 26 every corner of priority > outside lies
+      // behind the wall's plane; for the complement's analog (kappa = 6, lambda = 26) every
+      // corner of priority < inside lies in front of it.
+      const auto p0 = doubledMidpoint(t.edges[0]), p1 = doubledMidpoint(t.edges[1]), p2 = doubledMidpoint(t.edges[2]);
+      const std::array<int, 3> u{p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]}, v{p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+      const std::array<int, 3> n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+      ASSERT_NE(n, (std::array<int, 3>{0, 0, 0}));
+      for (int i = 0; i < 8; ++i) {
+        const Voxel q = cube::cornerOffset(i);
+        const int side = n[0] * (2 * q.x - p0[0]) + n[1] * (2 * q.y - p0[1]) + n[2] * (2 * q.z - p0[2]);
+        if (pair == AdjacencyPair::k26_6 && rank[std::size_t(i)] > t.outside) ASSERT_LE(side, 0) << "pattern " << c;
+        if (pair == AdjacencyPair::k6_26 && rank[std::size_t(i)] < t.inside) ASSERT_GE(side, 0) << "pattern " << c;
+      }
+      label[t.inside].push_back({t.edges[0], t.edges[1], t.edges[2]});
+      label[t.outside].push_back({t.edges[0], t.edges[2], t.edges[1]});
+    }
+    if (foreign) ++foreignPatterns;
+    for (int r = 0; r < levels; ++r) {
+      // Inner edges (not on one cube face) closed up: each directed edge once, its reverse once.
+      std::multiset<std::pair<int, int>> inner;
+      for (const auto& t : label[std::size_t(r)])
+        for (int j = 0; j < 3; ++j) {
+          const int a = t[std::size_t(j)], b = t[std::size_t((j + 1) % 3)];
+          const auto pa = doubledMidpoint(a), pb = doubledMidpoint(b);
+          int face = -1;
+          for (int axis = 0; axis < 3 && face < 0; ++axis)
+            for (int s : {0, 2})
+              if (pa[std::size_t(axis)] == s && pb[std::size_t(axis)] == s) face = 2 * axis + s / 2;
+          if (face < 0) inner.insert({a, b});
+        }
+      for (const auto& [a, b] : inner)
+        ASSERT_EQ(inner.count({a, b}), 1u) << "pattern " << c << " label " << r;
+      for (const auto& [a, b] : inner)
+        ASSERT_EQ(inner.count({b, a}), 1u) << "pattern " << c << " label " << r << " open at " << a << "-" << b;
+    }
+    // Per face and side, all labels' segments together: compared with the first cube seen.
+    for (int face = 0; face < 6; ++face) {
+      const int axis = face / 2, side = face % 2;
+      const auto [u, v] = cube::otherAxes(axis);
+      std::array<int, 4> corner{};
+      for (int j = 0; j < 4; ++j) corner[std::size_t(j)] = side << axis | (j & 1) << u | (j >> 1 & 1) << v;
+      std::array<std::uint8_t, 4> fr{};
+      for (int j = 0; j < 4; ++j) fr[std::size_t(j)] = rank[std::size_t(corner[std::size_t(j)])];
+      std::array<std::uint8_t, 4> sorted = fr;
+      std::sort(sorted.begin(), sorted.end());
+      const auto end = std::unique(sorted.begin(), sorted.end());
+      std::uint32_t key = 0;
+      for (int j = 0; j < 4; ++j)
+        key |= std::uint32_t(std::lower_bound(sorted.begin(), end, fr[std::size_t(j)]) - sorted.begin()) << (3 * j);
+      auto local = [&](int edge) {
+        const int lo = cube::edgeLowCorner(edge), hi = cube::edgeHighCorner(edge);
+        int a = -1, b = -1;
+        for (int j = 0; j < 4; ++j) {
+          if (corner[std::size_t(j)] == lo) a = j;
+          if (corner[std::size_t(j)] == hi) b = j;
+        }
+        return 4 * a + b;
+      };
+      auto onThisFace = [&](int edge) {
+        const auto p = doubledMidpoint(edge);
+        return p[std::size_t(axis)] == 2 * side;
+      };
+      std::vector<std::array<int, 3>> segs;  // (face-local label, from, to)
+      for (int r = 0; r < levels; ++r) {
+        // A label's segments on the face; a segment used both ways bounds a zero-thickness rim
+        // of the label's region (two of its sheets meeting on the face) and leaves no trace.
+        std::multiset<std::pair<int, int>> own;
+        for (const auto& t : label[std::size_t(r)])
+          for (int j = 0; j < 3; ++j) {
+            const int a = t[std::size_t(j)], b = t[std::size_t((j + 1) % 3)];
+            if (onThisFace(a) && onThisFace(b)) own.insert({a, b});
+          }
+        for (const auto& [a, b] : own) {
+          if (own.count({b, a})) continue;
+          ASSERT_EQ(own.count({a, b}), 1u) << "pattern " << c;
+          ASSERT_TRUE(std::binary_search(sorted.begin(), end, std::uint8_t(r)))
+              << "pattern " << c << ": label " << r << " has a trace on a face without its voxels";
+          const int fl = int(std::lower_bound(sorted.begin(), end, std::uint8_t(r)) - sorted.begin());
+          segs.push_back({fl, local(a), local(b)});
+        }
+      }
+      std::sort(segs.begin(), segs.end());
+      const auto [it, added] = traces.try_emplace({key, side}, segs);
+      if (!added) ASSERT_EQ(it->second, segs) << "pattern " << c << " face " << face << ": the trace is not the face's";
+    }
+  }
+  // The two cubes of a face see the same segments, reversed.
+  std::size_t faces = 0;
+  for (const auto& [key, segs] : traces) {
+    if (key.second != 0) continue;
+    const auto other = traces.find({key.first, 1});
+    if (other == traces.end()) continue;
+    ++faces;
+    std::vector<std::array<int, 3>> reversed;
+    for (const auto& s : other->second) reversed.push_back({s[0], s[2], s[1]});
+    std::sort(reversed.begin(), reversed.end());
+    EXPECT_EQ(segs, reversed) << "face pattern " << key.first;
+  }
+  if (!testing::kSanitizedBuild) EXPECT_EQ(faces, 75u);  // the ordered set partitions of 4 corners
+  std::cout << "[ study ] " << toString(pair) << ": " << checked << " priority patterns, " << threeOrMore
+            << " with >= 3 labels, " << foreignPatterns
+            << " where a label's triangles use a vertex between two other labels; at most " << maxTriangles
+            << " walls per cube; " << faces << " face patterns\n";
+}
+
+INSTANTIATE_TEST_SUITE_P(Pairs, SharedWallCubes, ::testing::ValuesIn(kAllAdjacencyPairs), testing::pairTestName);
+
+// ---------------------------------------------------------------------------------------------
+// Random label images.
+
+using Key3 = std::array<long long, 3>;  // a point, doubled: exact for midpoints
+using DirectedTriangle = std::array<Key3, 3>;  // rotated so that the least point comes first
+
+Key3 keyOf(const std::array<double, 3>& p) {
+  Key3 k;
+  for (int i = 0; i < 3; ++i) {
+    const double d = 2 * p[std::size_t(i)];
+    k[std::size_t(i)] = std::llround(d);
+    EXPECT_EQ(double(k[std::size_t(i)]), d) << "a vertex off the half-integer grid";
+  }
+  return k;
+}
+
+DirectedTriangle directed(Key3 a, Key3 b, Key3 c) {
+  DirectedTriangle t{a, b, c};
+  std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+  return t;
+}
+
+DirectedTriangle reversedOf(const DirectedTriangle& t) { return directed(t[0], t[2], t[1]); }
+
+/// Every triangle of every surface, with its label index.
+std::map<DirectedTriangle, std::vector<int>> trianglesByLabel(const std::vector<LabelSurface>& surfaces) {
+  std::map<DirectedTriangle, std::vector<int>> out;
+  for (std::size_t l = 0; l < surfaces.size(); ++l) {
+    const Surface& s = surfaces[l].surface;
+    for (const auto& t : s.triangles)
+      out[directed(keyOf(s.vertices[t[0]]), keyOf(s.vertices[t[1]]), keyOf(s.vertices[t[2]]))].push_back(int(l));
+  }
+  return out;
+}
+
+std::vector<std::uint16_t> randomLabels(std::mt19937_64& rng, Dims dims, int count, bool withBackground) {
+  std::vector<std::uint16_t> palette;
+  std::uniform_int_distribution<int> value(1, 5000);
+  while (int(palette.size()) < count) {
+    const auto v = std::uint16_t(value(rng));
+    if (std::find(palette.begin(), palette.end(), v) == palette.end()) palette.push_back(v);
+  }
+  if (withBackground) palette[0] = 0;
+  std::vector<std::uint16_t> data(std::size_t(dims.nx) * std::size_t(dims.ny) * std::size_t(dims.nz));
+  // Half the images: blobs (each voxel copies a neighbour now and then) rather than pure noise.
+  const bool blobs = rng() % 2;
+  std::uniform_int_distribution<int> pick(0, count - 1);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    data[i] = palette[std::size_t(pick(rng))];
+    if (blobs && i > 0 && rng() % 3) data[i] = data[i - 1 - std::size_t(rng() % std::min<std::size_t>(i, 30))];
+  }
+  return data;
+}
+
+TEST(SharedWalls, ThousandRandomLabelImages) {
+  std::mt19937_64 rng(2026);
+  std::size_t images = 0, labelsSeen = 0, pinchedLabels = 0, copies = 0, pinchedEdges = 0, points = 0, walls = 0;
+  for (int image = 0; image < 1000; ++image) {
+    std::uniform_int_distribution<int> side(2, 5);
+    const Dims dims{side(rng), side(rng), side(rng)};
+    const int count = std::uniform_int_distribution<int>(2, 40)(rng);
+    const bool withBackground = image % 2 == 0;
+    const std::vector<std::uint16_t> data = randomLabels(rng, dims, count, withBackground);
+    if (!caseChecked(std::uint64_t(image))) continue;
+    ++images;
+    LabelOptions options;
+    options.walls = LabelWalls::Shared;
+    options.threads = 1;
+    options.background = withBackground ? 0 : 65535;  // absent: only the outside is background
+    const VolumeView view = VolumeView::of(data.data(), dims);
+    const std::vector<LabelSurface> surfaces = extractLabels(view, options);
+    // Priorities: the background 0, then by increasing label (the surfaces come in that order).
+    std::vector<std::uint16_t> values(data);
+    std::sort(values.begin(), values.end());
+    values.erase(std::unique(values.begin(), values.end()), values.end());
+    if (withBackground && values[0] == 0) values.erase(values.begin());
+    ASSERT_EQ(surfaces.size(), values.size());
+    for (std::size_t l = 0; l < values.size(); ++l) ASSERT_EQ(surfaces[l].label, LabelValue(values[l]));
+    auto priorityOf = [&](Voxel v) -> int {  // 0 background or outside, 1 + label index
+      if (!dims.contains(v)) return 0;
+      const std::uint16_t x = data[std::size_t(v.x) + std::size_t(dims.nx) * (std::size_t(v.y) + std::size_t(dims.ny) * std::size_t(v.z))];
+      if (withBackground && x == 0) return 0;
+      return int(std::lower_bound(values.begin(), values.end(), x) - values.begin()) + 1;
+    };
+
+    // Twins: each triangle of label A reversed in exactly one other label B (A inside, B outside)
+    // or, when it has none, the background outside.
+    const auto all = trianglesByLabel(surfaces);
+    std::map<DirectedTriangle, int> outsideOf;  // priority outside each directed triangle
+    for (const auto& [t, owners] : all) {
+      ASSERT_EQ(owners.size(), 1u) << "image " << image << ": a triangle twice in one orientation";
+      const auto twin = all.find(reversedOf(t));
+      if (twin != all.end()) {
+        ASSERT_NE(twin->second[0], owners[0]) << "image " << image << ": a label's triangle and its reverse";
+        outsideOf[t] = twin->second[0] + 1;
+      } else {
+        if (!withBackground) {
+          // Only the outside of the domain is background: the triangle lies over the border.
+          for (const Key3& p : t) {
+            bool border = false;
+            for (int a = 0; a < 3; ++a) {
+              const int n = a == 0 ? dims.nx : a == 1 ? dims.ny : dims.nz;
+              border |= p[std::size_t(a)] == -1 || p[std::size_t(a)] == 2 * n - 1;
+            }
+            ASSERT_TRUE(border) << "image " << image << ": a wall without its twin inside the domain";
+          }
+        }
+        outsideOf[t] = 0;
+      }
+      ++walls;
+    }
+    // The walls between priorities >= t and < t are the binary surface of priority >= t, made by
+    // the independent path (26-6, the pair of the levels).
+    const int levels = int(values.size());
+    for (int t = 1; t <= levels; ++t) {
+      std::vector<std::uint8_t> binary(data.size());
+      for (int z = 0, i = 0; z < dims.nz; ++z)
+        for (int y = 0; y < dims.ny; ++y)
+          for (int x = 0; x < dims.nx; ++x, ++i) binary[std::size_t(i)] = priorityOf({x, y, z}) >= t;
+      std::set<DirectedTriangle> expected;
+      if (std::count(binary.begin(), binary.end(), 1)) {
+        LabelOptions b;
+        b.threads = 1;
+        b.labels = LabelSelection::list({LabelValue(1)});
+        const auto level = extractLabels(VolumeView::of(binary.data(), dims), b);
+        const Surface& s = level.at(0).surface;
+        for (const auto& tri : s.triangles)
+          expected.insert(directed(keyOf(s.vertices[tri[0]]), keyOf(s.vertices[tri[1]]), keyOf(s.vertices[tri[2]])));
+      }
+      std::set<DirectedTriangle> got;
+      for (const auto& [tri, owners] : all)
+        if (owners[0] + 1 >= t && outsideOf[tri] < t) got.insert(tri);
+      ASSERT_EQ(got, expected) << "image " << image << ": level " << t;
+    }
+    // Each label: a closed oriented 2-manifold; vertices at one point are exactly its pinch copies.
+    for (const LabelSurface& l : surfaces) {
+      const Surface& s = l.surface;
+      const checks::Topology topology = checks::topologyOf(s.vertices.size(), s.triangles);
+      ASSERT_TRUE(topology.manifoldVertices) << "image " << image << " label " << l.label.text() << ": " << topology.problem;
+      ASSERT_EQ(topology.euler, s.euler);
+      std::vector<Key3> keys;
+      for (const auto& p : s.vertices) keys.push_back(keyOf(p));
+      std::sort(keys.begin(), keys.end());
+      const auto distinct = std::size_t(std::unique(keys.begin(), keys.end()) - keys.begin());
+      ASSERT_EQ(s.vertices.size() - distinct, l.pinchCopies) << "image " << image;
+      ++labelsSeen;
+      if (l.pinchCopies) ++pinchedLabels;
+      copies += l.pinchCopies;
+      pinchedEdges += l.pinchedEdges;
+    }
+    // Inside exactly one label or the background: voxel centres (in their own label) and random
+    // points, by winding numbers.
+    std::vector<TriangleMesh> meshes(surfaces.size());
+    for (std::size_t l = 0; l < surfaces.size(); ++l) meshes[l].triangles = surfaces[l].surface.triangles;
+    auto check = [&](const testing::Point& q, int expected) {
+      double sum = 0;
+      int inside = 0;
+      for (std::size_t l = 0; l < surfaces.size(); ++l) {
+        const double w = testing::windingNumber(meshes[l], surfaces[l].surface.vertices, q);
+        ASSERT_NEAR(w, std::round(w), 1e-6);
+        ASSERT_TRUE(std::round(w) == 0 || std::round(w) == 1) << "winding " << w;
+        if (std::round(w) == 1) inside = int(l) + 1;
+        sum += std::round(w);
+      }
+      ASSERT_LE(sum, 1) << "image " << image << ": a point inside two labels";
+      if (expected >= 0) ASSERT_EQ(inside, expected) << "image " << image;
+      ++points;
+    };
+    for (int z = 0; z < dims.nz; ++z)
+      for (int y = 0; y < dims.ny; ++y)
+        for (int x = 0; x < dims.nx; ++x) check({double(x), double(y), double(z)}, priorityOf({x, y, z}));
+    std::uniform_real_distribution<double> unit(0, 1);
+    for (int k = 0; k < 40; ++k)
+      check({-0.9 + unit(rng) * (dims.nx + 0.8), -0.9 + unit(rng) * (dims.ny + 0.8), -0.9 + unit(rng) * (dims.nz + 0.8)}, -1);
+  }
+  EXPECT_GE(images, testing::subsetMinimum(1000));
+  std::cout << "[ study ] " << images << " random images, " << labelsSeen << " labels, " << walls
+            << " directed wall triangles, " << points << " points; " << pinchedLabels << " labels with pinches, "
+            << copies << " vertex copies, " << pinchedEdges << " pinched edges\n";
+}
+
+/// The smallest pinch (docs/theory.md, "Shared walls"): label 1 at (1, 2, 2) and (1, 0, 0), label
+/// 2 at (1, 1, 1) between them, the background elsewhere. Label 1's two regions both reach the
+/// vertex between (1, 1, 1) and (2, 1, 1), (0, 1, 1), from opposite cubes.
+TEST(SharedWalls, TheSmallestPinch) {
+  const Dims dims{3, 3, 3};
+  std::vector<std::uint8_t> data(27, 0);
+  auto at = [&](int x, int y, int z) -> std::uint8_t& { return data[std::size_t(x + 3 * (y + 3 * z))]; };
+  at(1, 1, 1) = 2;
+  at(1, 2, 2) = 1;
+  at(1, 0, 0) = 1;
+  LabelOptions options;
+  options.walls = LabelWalls::Shared;
+  const auto surfaces = extractLabels(VolumeView::of(data.data(), dims), options);
+  ASSERT_EQ(surfaces.size(), 2u);
+  const LabelSurface& one = surfaces[0];
+  EXPECT_GT(one.pinchCopies, 0u);
+  EXPECT_EQ(surfaces[1].pinchCopies, 0u);
+  const checks::Topology topology = checks::topologyOf(one.surface.vertices.size(), one.surface.triangles);
+  EXPECT_TRUE(topology.manifoldVertices) << topology.problem;
+  EXPECT_FALSE(one.surface.warnings.empty());
+  std::cout << "[ study ] smallest pinch: label 1 has " << one.pinchCopies << " copies, " << one.pinchedEdges
+            << " pinched edges, " << topology.components << " components, euler " << topology.euler << "\n";
+}
+
+TEST(SharedWalls, Refusals) {
+  std::vector<std::uint8_t> data(8, 1);
+  LabelOptions options;
+  options.walls = LabelWalls::Shared;
+  options.boundaries = LabelBoundaries::Largest;
+  EXPECT_THROW(extractLabels(VolumeView::of(data.data(), Dims{2, 2, 2}), options), InvalidInput);
+  options.boundaries = LabelBoundaries::All;
+  options.seeds = {Voxel{0, 0, 0}};
+  EXPECT_THROW(extractLabels(VolumeView::of(data.data(), Dims{2, 2, 2}), options), InvalidInput);
+}
+
+}  // namespace
+}  // namespace surftrack
