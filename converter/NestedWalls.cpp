@@ -26,7 +26,7 @@ CubeWalls cubeWalls(const std::array<std::uint8_t, 8>& rank, AdjacencyPair pair)
     for (const auto& tri : configurationTable(pair, config).allTriangles()) {
       std::array<std::uint8_t, 3> sorted = tri;
       std::sort(sorted.begin(), sorted.end());
-      Seen* s = std::find_if(seen.begin(), seen.begin() + n, [&](const Seen& x) { return x.sorted == sorted; });
+      const auto s = std::find_if(seen.begin(), seen.begin() + n, [&](const Seen& x) { return x.sorted == sorted; });
       if (s == seen.begin() + n) {
         if (n == CubeWalls::kMaxTriangles) throw std::logic_error("cubeWalls: too many triangles");
         seen[std::size_t(n++)] = {tri, sorted, t, t};
