@@ -31,6 +31,7 @@
 #include "MeshChecks.h"
 #include "NestedWalls.h"
 #include "PairTestName.h"
+#include "TriangleIntersection.h"
 
 namespace surftrack {
 namespace {
@@ -68,6 +69,14 @@ std::array<int, 3> doubledMidpoint(int edge) {
   return {a.x + b.x, a.y + b.y, a.z + b.z};
 }
 
+using I3 = std::array<long, 3>;
+I3 minus(const I3& a, const I3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+I3 crossOf(const I3& a, const I3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+long dotOf(const I3& a, const I3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+
 class SharedWallCubes : public ::testing::TestWithParam<AdjacencyPair> {};
 
 TEST_P(SharedWallCubes, EveryPriorityPatternOfACube) {
@@ -78,7 +87,7 @@ TEST_P(SharedWallCubes, EveryPriorityPatternOfACube) {
   // edge pairs; face edge j of the face normal to axis a: the cube edge parallel to the other
   // axis u or v, in the face's own numbering.
   std::map<std::pair<std::uint32_t, int>, std::vector<std::array<int, 3>>> traces;
-  std::size_t checked = 0, foreignPatterns = 0, threeOrMore = 0, maxTriangles = 0;
+  std::size_t pairsTested = 0, checked = 0, foreignPatterns = 0, threeOrMore = 0, maxTriangles = 0;
   for (std::size_t c = 0; c < patterns.size(); ++c) {
     if (!caseChecked(c)) continue;
     ++checked;
@@ -124,6 +133,42 @@ TEST_P(SharedWallCubes, EveryPriorityPatternOfACube) {
       label[t.outside].push_back({t.edges[0], t.edges[2], t.edges[1]});
     }
     if (foreign) ++foreignPatterns;
+    // The walls of a cube meet only in the vertices and edges they share (refine/'s exact-enough
+    // test, itself checked against CGAL in test_refine): a planar face subdivided differently at
+    // two levels, or a hull touching another level's face along a segment across its triangles,
+    // would not. Pairs strictly on one side of either's plane cannot meet and are skipped.
+    for (int w = 0; w < walls.count; ++w)
+      for (int x = w + 1; x < walls.count; ++x) {
+        std::array<I3, 3> a, b;
+        refine::Triangle3 ta, tb;
+        for (int j = 0; j < 3; ++j) {
+          const auto pa = doubledMidpoint(walls.triangles[std::size_t(w)].edges[std::size_t(j)]);
+          const auto pb = doubledMidpoint(walls.triangles[std::size_t(x)].edges[std::size_t(j)]);
+          a[std::size_t(j)] = {pa[0], pa[1], pa[2]};
+          b[std::size_t(j)] = {pb[0], pb[1], pb[2]};
+          ta[std::size_t(j)] = {double(pa[0]), double(pa[1]), double(pa[2])};
+          tb[std::size_t(j)] = {double(pb[0]), double(pb[1]), double(pb[2])};
+        }
+        auto strictlyAside = [](const std::array<I3, 3>& plane, const std::array<I3, 3>& t) {
+          const I3 n = crossOf(minus(plane[1], plane[0]), minus(plane[2], plane[0]));
+          int below = 0, above = 0;
+          for (const I3& p : t) {
+            const long d = dotOf(n, minus(p, plane[0]));
+            below += d < 0;
+            above += d > 0;
+          }
+          return below == 3 || above == 3;
+        };
+        if (strictlyAside(a, b) || strictlyAside(b, a)) continue;
+        std::vector<int> shared;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (walls.triangles[std::size_t(w)].edges[std::size_t(i)] == walls.triangles[std::size_t(x)].edges[std::size_t(j)])
+              shared.push_back(3 * i + j);
+        ASSERT_FALSE(refine::trianglesMeetOutsideShared(ta, tb, shared, 1e-9))
+            << "pattern " << c << ": walls " << w << " and " << x << " meet improperly";
+        ++pairsTested;
+      }
     for (int r = 0; r < levels; ++r) {
       // Inner edges (not on one cube face) closed up: each directed edge once, its reverse once.
       std::multiset<std::pair<int, int>> inner;
@@ -209,7 +254,8 @@ TEST_P(SharedWallCubes, EveryPriorityPatternOfACube) {
   std::cout << "[ study ] " << toString(pair) << ": " << checked << " priority patterns, " << threeOrMore
             << " with >= 3 labels, " << foreignPatterns
             << " where a label's triangles use a vertex between two other labels; at most " << maxTriangles
-            << " walls per cube; " << faces << " face patterns\n";
+            << " walls per cube; " << faces << " face patterns; " << pairsTested
+            << " pairs of walls tested for intersection\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(Pairs, SharedWallCubes, ::testing::ValuesIn(kAllAdjacencyPairs), testing::pairTestName);
@@ -266,6 +312,23 @@ std::vector<std::uint16_t> randomLabels(std::mt19937_64& rng, Dims dims, int cou
     if (blobs && i > 0 && rng() % 3) data[i] = data[i - 1 - std::size_t(rng() % std::min<std::size_t>(i, 30))];
   }
   return data;
+}
+
+/// The Euler characteristic of the union of the closed unit cubes centred at `voxels` (the
+/// 26-6 solid of a binary image, docs/theory.md §9), by counting its cells in doubled
+/// coordinates: a cell's dimension is its number of odd coordinates.
+long closedCubesEuler(const std::vector<Voxel>& voxels) {
+  std::set<std::array<int, 3>> cells;
+  for (const Voxel& v : voxels)
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) cells.insert({2 * v.x + dx, 2 * v.y + dy, 2 * v.z + dz});
+  long chi = 0;
+  for (const auto& c : cells) {
+    const int odd = (c[0] & 1) + (c[1] & 1) + (c[2] & 1);
+    chi += odd % 2 ? -1 : 1;
+  }
+  return chi;
 }
 
 TEST(SharedWalls, ThousandRandomLabelImages) {
@@ -348,6 +411,16 @@ TEST(SharedWalls, ThousandRandomLabelImages) {
         if (owners[0] + 1 >= t && outsideOf[tri] < t) got.insert(tri);
       ASSERT_EQ(got, expected) << "image " << image << ": level " << t;
     }
+    // chi(V_t): the level sets' solids (the 26-6 analog of B_t has the topology of its voxels).
+    std::vector<long> chiLevel(std::size_t(levels) + 2, 0);
+    for (int t = 1; t <= levels; ++t) {
+      std::vector<Voxel> at;
+      for (int z = 0; z < dims.nz; ++z)
+        for (int y = 0; y < dims.ny; ++y)
+          for (int x = 0; x < dims.nx; ++x)
+            if (priorityOf({x, y, z}) >= t) at.push_back({x, y, z});
+      chiLevel[std::size_t(t)] = closedCubesEuler(at);
+    }
     // Each label: a closed oriented 2-manifold; vertices at one point are exactly its pinch copies.
     for (const LabelSurface& l : surfaces) {
       const Surface& s = l.surface;
@@ -359,6 +432,40 @@ TEST(SharedWalls, ThousandRandomLabelImages) {
       std::sort(keys.begin(), keys.end());
       const auto distinct = std::size_t(std::unique(keys.begin(), keys.end()) - keys.begin());
       ASSERT_EQ(s.vertices.size() - distinct, l.pinchCopies) << "image " << image;
+      // Its Euler characteristic (docs/theory.md §12): R_t = closure(V_t minus V_t+1), so
+      // chi(R_t) = chi(V_t) - chi(V_t+1) + chi(S), S = R_t n V_t+1 the part of its mesh spanned
+      // by the vertices on edges reaching priority t + 1 (each cube's hulls are convex); opening
+      // the pinches adds the vertex copies and removes the extra sheets of pinched edges; the
+      // opened region is a 3-manifold whose boundary, the mesh, has chi = 2 chi(region).
+      const int p = int(&l - surfaces.data()) + 1;
+      auto onHigher = [&](const Key3& k) {
+        Voxel c{}, d{};
+        for (int a = 0; a < 3; ++a) {
+          const long long lo = (k[std::size_t(a)] - (k[std::size_t(a)] & 1)) / 2;
+          c[a] = int(lo);
+          d[a] = int(lo + (k[std::size_t(a)] & 1));
+        }
+        return std::max(priorityOf(c), priorityOf(d)) > p;
+      };
+      std::map<std::array<Key3, 2>, int> edgeUses;
+      std::set<std::array<Key3, 3>> faces;
+      for (const auto& t : s.triangles) {
+        std::array<Key3, 3> k{keyOf(s.vertices[t[0]]), keyOf(s.vertices[t[1]]), keyOf(s.vertices[t[2]])};
+        std::sort(k.begin(), k.end());
+        faces.insert(k);
+        ++edgeUses[{k[0], k[1]}];
+        ++edgeUses[{k[1], k[2]}];
+        ++edgeUses[{k[0], k[2]}];
+      }
+      long chiS = 0, edgeCopies = 0;
+      for (std::size_t v = 0; v < distinct; ++v) chiS += onHigher(keys[v]);
+      for (const auto& [e, uses] : edgeUses) {
+        chiS -= onHigher(e[0]) && onHigher(e[1]);
+        edgeCopies += uses / 2 - 1;
+      }
+      for (const auto& f : faces) chiS += onHigher(f[0]) && onHigher(f[1]) && onHigher(f[2]);
+      const long region = chiLevel[std::size_t(p)] - chiLevel[std::size_t(p) + 1] + chiS + long(l.pinchCopies) - edgeCopies;
+      EXPECT_EQ(topology.euler, 2 * region) << "image " << image << " label " << l.label.text();
       ++labelsSeen;
       if (l.pinchCopies) ++pinchedLabels;
       copies += l.pinchCopies;
