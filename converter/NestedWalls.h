@@ -32,8 +32,8 @@ struct CubeWalls {
 };
 
 /// The walls of a cube whose corner i has local rank rank[i] (the ranks present are 0..k-1,
-/// k <= 8, in priority order; a rank is a label), every level's analog that of `pair` (each is
-/// monotone: docs/theory.md). The triangle of level t's table entry that is a
+/// k <= 8, in priority order; a rank is a label), every level's analog that of `pair`, 26-6 or
+/// 6-26 (one convex hull per cube and level, or its complement's). The triangle of level t's table entry that is a
 /// face of V_s for exactly the levels s in [outside + 1, inside] is one wall between `inside`
 /// and `outside`. Throws std::logic_error if a triangle's levels are not one interval or its
 /// orientation changes between levels (neither happens: tests/test_shared_walls.cpp).

@@ -66,7 +66,9 @@ PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
     if (n == 2 && runsLowToHigh(sides[b]) != runsLowToHigh(sides[b + 1])) {
       pair(sides[b], sides[b + 1]);
     } else {
-      if (n % 2) throw std::logic_error("splitPinches: an edge has an odd number of triangles");
+      std::size_t forward = 0;
+      for (std::size_t i = b; i < e; ++i) forward += runsLowToHigh(sides[i]);
+      if (2 * forward != n) throw std::logic_error("splitPinches: an edge's triangles are not matched in orientation");
       ++out.pinchedEdges;
       // Angles around d = hi - lo, counter-clockwise (right-hand rule about d).
       const P& a = points[sides[b].lo];
@@ -112,6 +114,19 @@ PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
       }
       out.triangles[t][j] = copy[root];
     }
+  std::vector<std::uint64_t> edges;
+  for (const auto& t : out.triangles)
+    for (int j = 0; j < 3; ++j) {
+      const std::uint64_t a = t[std::size_t(j)], b = t[std::size_t((j + 1) % 3)];
+      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t e = i;
+    while (e < edges.size() && edges[e] == edges[i]) ++e;
+    out.unsplitEdges += e - i > 2;
+    i = e;
+  }
   return out;
 }
 

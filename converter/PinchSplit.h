@@ -5,7 +5,9 @@
 // the triangles are paired across the k sectors of R between them (by angle around the edge);
 // around a vertex, the triangles joined through paired edges form one fan each, and every fan
 // but the first gets a new copy of the vertex, at the same point. Nothing moves; the wall
-// triangles stay shared (the same points, the same surfels).
+// triangles stay shared (the same points, the same surfels). A pinched edge whose sheets are
+// joined around both its ends (the region wraps round and touches itself along the edge) is not
+// separated by any copy of a vertex: it stays, counted (unsplitEdges).
 #pragma once
 
 #include <array>
@@ -20,6 +22,9 @@ struct PinchSplit {
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::uint32_t> copyOf;
   std::size_t pinchedEdges = 0;  ///< edges of more than 2 triangles
+  /// Pinched edges whose sheets are joined around both of their ends, so that no vertex copy
+  /// separates them: still edges of more than 2 triangles after the split.
+  std::size_t unsplitEdges = 0;
 };
 
 /// Splits the pinches of a closed oriented triangle 2-cycle (every directed edge matched by as

@@ -217,6 +217,8 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
   if (o.walls == LabelWalls::Shared) {
     if (fromSeeds || o.boundaries != LabelBoundaries::All)
       throw InvalidInput("shared walls partition the whole image: every boundary of every label, no seeds or largest");
+    if (o.pair != AdjacencyPair::k26_6 && o.pair != AdjacencyPair::k6_26)
+      throw InvalidInput("shared walls take the adjacency pair 26-6 or 6-26, not " + toString(o.pair));
     return sharedWallSurfaces(image, source, o, [&](const std::vector<T>& labels) {
       return selectLabels(labels, o.labels, o.background);
     });

@@ -149,10 +149,12 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     requirePlacedVertices(geometry, s.vertices, [&](std::size_t v) { return MidpointMapping{}(s.surfels[v]); });
     result.pinchCopies = split.copyOf.size();
     result.pinchedEdges = split.pinchedEdges;
-    if (!split.copyOf.empty())
-      s.warnings.push_back("label " + result.label.text() + ": " + std::to_string(split.copyOf.size()) +
-                           " vertex copies split pinches where the label touches itself (" +
-                           std::to_string(split.pinchedEdges) + " pinched edges; docs/theory.md, shared walls)");
+    result.unsplitEdges = split.unsplitEdges;
+    if (!split.copyOf.empty() || split.pinchedEdges)
+      s.warnings.push_back("label " + result.label.text() + " touches itself: " + std::to_string(split.copyOf.size()) +
+                           " vertex copies, " + std::to_string(split.pinchedEdges) + " pinched edges, " +
+                           std::to_string(split.unsplitEdges) +
+                           " of them left with four triangles (docs/theory.md §12, pinches)");
     finishScannedLabel(s, mirrored, o);
   }
   return out;

@@ -59,8 +59,9 @@ enum class LabelWalls {
   /// increasing label), each wall one set of triangles used by the two labels it separates with
   /// opposite orientations, the regions a partition of space, vertices the surfels between
   /// differing labels. Where a label touches itself at a vertex or along an edge (a pinch) its
-  /// surface gets a copy of the vertex per sheet (LabelSurface::pinchCopies). Every boundary of
-  /// every label: no seeds, not LabelBoundaries::Largest.
+  /// surface gets a copy of the vertex per sheet (LabelSurface::pinchCopies), where a copy can
+  /// separate them. Every boundary of
+  /// every label: no seeds, not LabelBoundaries::Largest; pairs 26-6 and 6-26 only.
   Shared
 };
 
@@ -96,8 +97,10 @@ struct LabelSurface {
   /// of the label for LabelBoundaries::All and Largest, 0 (not counted) with seeds.
   Surface surface;
   /// LabelWalls::Shared: vertex copies made where the label touches itself (pinches), each at the
-  /// same point and surfel as its original; and the edges of more than two of its triangles.
-  std::size_t pinchCopies = 0, pinchedEdges = 0;
+  /// same point and surfel as its original; the edges of more than two of its triangles; and
+  /// those of them no copy separates (still of four or more triangles: the surface is a closed
+  /// oriented 2-cycle but not a 2-manifold there).
+  std::size_t pinchCopies = 0, pinchedEdges = 0, unsplitEdges = 0;
 };
 
 /// The surfaces of the selected labels of `view`, by increasing label. Labels are exact over
