@@ -208,6 +208,13 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   } else if (kind == OutputKind::OnePly) {
     writeLabelSurfaces(surfaces, o.output, binary);
   } else {
+    // A mesh file holds a 2-manifold; shared walls may leave a label edges of four triangles
+    // (docs/theory.md §12), which only the one PLY of every label carries.
+    for (const LabelSurface& ls : surfaces)
+      if (ls.unsplitEdges)
+        throw InvalidInput("label " + ls.label.text() + " has " + std::to_string(ls.unsplitEdges) +
+                           " edges of four triangles with --walls shared (it touches itself along them): write every "
+                           "label to one .ply (-o FILE.ply) instead");
     for (std::size_t i = 0; i < surfaces.size(); ++i) writeSurface(surfaces[i].surface, staged.temporaryFor(rows[i].file), binary);
     if (kind == OutputKind::Directory) writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(rows));
     staged.commit();
