@@ -89,3 +89,33 @@ def test_bad_walls_and_refusals():
         surftrack.label_surfaces(labels, walls="both")
     with pytest.raises(ValueError):
         surftrack.label_surfaces(labels, walls="shared", boundaries="largest")
+
+
+def cli():
+    import os
+    import pathlib
+    path = os.environ.get("SURFTRACK_CLI") or str(
+        pathlib.Path(__file__).resolve().parents[2] / "build" / "cli" / "surftrack")
+    assert os.access(path, os.X_OK), f"the surftrack CLI is not built at {path}"
+    return path
+
+
+def test_cli_walls(tmp_path, rng):
+    import json
+    import subprocess
+    a = rng.integers(0, 5, size=(6, 5, 4)).astype(np.uint8)
+    a.tofile(tmp_path / "a.raw")
+    raw = ["--raw-dims", "4,5,6", "--raw-type", "uint8"]
+    r = subprocess.run([cli(), "labels", "a.raw", *raw, "-o", "all.ply", "--walls", "shared", "--json", "--threads", "1"],
+                       cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    report = json.loads(r.stdout)
+    assert report["walls"] == "shared"
+    # The same meshes as the Python binding's (C order: the raw file's x is the last axis).
+    surfaces = shared(a)
+    rows = {row["label"]: row for row in report["labels"]}
+    for label, s in surfaces.items():
+        assert rows[label]["triangles"] == len(s.faces), label
+    r = subprocess.run([cli(), "labels", "a.raw", *raw, "-o", "all.ply", "--walls", "both"], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode != 0 and "--walls" in r.stderr
