@@ -67,6 +67,24 @@ io::ChunkedStoreOptions chunkedStoreOptions(const InputOptions& input) {
   return chosen;
 }
 
+std::optional<std::string> wholeReadRefusal(const io::ChunkedStore& store, const std::string& path) {
+  const ChunkLayout& layout = store.provider->layout();
+  const double bytes = double(layout.dims.count()) * double(sizeOf(layout.type));
+  const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
+  auto gib = [](double b) {
+    std::ostringstream s;
+    s.precision(3);
+    s << b / double(1 << 30);
+    return s.str();
+  };
+  if (memory > 0 && bytes > memory / 2)
+    return "cannot read '" + path + "' whole: its voxels take " + gib(bytes) +
+           " GiB, more than half of this machine's " + gib(memory) +
+           " GiB; `mesh` with a seed rule and --iso or --label reads only the chunks its surface "
+           "crosses, and surftrack.distributed meshes every label by blocks";
+  return std::nullopt;
+}
+
 bool isChunkedInput(const InputOptions& input) {
   const bool store = !input.raw && io::isChunkedStore(input.path);
   if (!store && (input.level || input.time))
@@ -92,23 +110,9 @@ std::string applyGeometryOptions(const InputOptions& input, ImageGeometry& g, co
 
 namespace {
 
-/// A chunked store is decoded whole only when its voxels take at most half the machine's
-/// memory: beyond, the message names what reads it in parts instead.
+/// The store's voxels decoded whole, or the error that refuses it.
 void requireLoadable(const io::ChunkedStore& store, const std::string& path) {
-  const ChunkLayout& layout = store.provider->layout();
-  const double bytes = double(layout.dims.count()) * double(sizeOf(layout.type));
-  const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
-  auto gib = [](double b) {
-    std::ostringstream s;
-    s.precision(3);
-    s << b / double(1 << 30);
-    return s.str();
-  };
-  if (memory > 0 && bytes > memory / 2)
-    throw io::ReadError("cannot read '" + path + "' whole: its voxels take " + gib(bytes) +
-                        " GiB, more than half of this machine's " + gib(memory) +
-                        " GiB; `mesh` with a seed rule and --iso or --label reads only the chunks its surface "
-                        "crosses, and surftrack.distributed meshes every label by blocks");
+  if (const auto refusal = wholeReadRefusal(store, path)) throw io::ReadError(*refusal);
 }
 
 }  // namespace

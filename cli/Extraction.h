@@ -132,6 +132,9 @@ void extractSurface(const VoxelSource& source, const VolumeView* whole, const Su
 /// Whether the input is a chunked store (zarr, OME-Zarr, N5); --level and --time are refused
 /// for any other input.
 bool isChunkedInput(const InputOptions& input);
+/// Why a chunked store is not decoded whole (its voxels take more than half the machine's
+/// memory; the message names what reads it in parts instead), or nothing when it may be.
+std::optional<std::string> wholeReadRefusal(const io::ChunkedStore& store, const std::string& path);
 /// The level, channel and time to read in a chunked store.
 io::ChunkedStoreOptions chunkedStoreOptions(const InputOptions& input);
 /// Applies --frame ras, --spacing and --origin to `geometry`; returns the frame.

@@ -14,6 +14,7 @@
 #include "LabelsCommand.h"
 
 #include "Commands.h"
+#include "DaskLabels.h"
 #include "LabelNames.h"
 #include "Labels.h"
 #include "MeshIO.h"
@@ -139,6 +140,19 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   LabelsRun run;
   run.namesFile = namesFile;
   std::vector<StageTiming>& timings = run.timings;
+  if (!o.dask.empty()) {
+    // By blocks on Dask: the same files and table, no volume in this process (DaskLabels.h).
+    if (kind != OutputKind::Directory)
+      throw UsageError("--dask writes -o DIR/ (one file per label), not '" + o.output + "'");
+    if (o.walls != "independent") throw UsageError("--walls shared is not made by blocks yet: no --dask");
+    run.rows = labelRowsOnDask(o, names, staged);
+    clock.lap(timings, "dask");
+    writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(run.rows));
+    staged.commit();
+    if (!o.table.empty()) writeText(o.table, tableText(o.table, run.rows));
+    clock.lap(timings, "write");
+    return run;
+  }
   const io::LoadedVolume volume = readInput(o.input);  // mapped or decoded, never copied
   if (!o.out.quiet)
     for (const std::string& w : volume.warnings) std::cerr << "surftrack: warning: " << w << "\n";

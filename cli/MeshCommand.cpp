@@ -1,10 +1,12 @@
 // `surftrack mesh INPUT -o OUTPUT [options]`.
+#include <filesystem>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 
 #include "ChunkedSource.h"
 #include "Commands.h"
+#include "DaskJob.h"
 #include "Extraction.h"
 #include "OutputFile.h"
 #include "Report.h"
@@ -12,28 +14,6 @@
 namespace surftrack::cli {
 
 namespace {
-
-/// A source whose voxels are another's and whose geometry is `geometry`: --frame, --spacing and
-/// --origin on a chunked store read lazily (its layout's geometry is the store's).
-class WithGeometry final : public VoxelSource {
- public:
-  WithGeometry(std::unique_ptr<VoxelSource> source, const ImageGeometry& geometry)
-      : source_(std::move(source)), geometry_(geometry) {}
-  Dims dims() const override { return source_->dims(); }
-  ImageGeometry geometry() const override { return geometry_; }
-  ScalarType type() const override { return source_->type(); }
-  void binaryBlock(const Selection& s, Voxel origin, int width, int ny, int nz, std::uint16_t* out) const override {
-    source_->binaryBlock(s, origin, width, ny, nz, out);
-  }
-  std::uint64_t binaryRow(const Selection& s, Voxel start, int count) const override {
-    return source_->binaryRow(s, start, count);
-  }
-  void values(const Voxel* voxels, std::size_t n, double* out) const override { source_->values(voxels, n, out); }
-
- private:
-  std::unique_ptr<VoxelSource> source_;
-  ImageGeometry geometry_;
-};
 
 /// A seeded extraction with --iso or --label from a chunked store, read lazily: only the chunks
 /// the surface crosses are decoded, through a cache of --cache MiB (docs/cli.md, "Input formats").
@@ -43,7 +23,8 @@ void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progr
   const ChunkLayout& layout = cache->layout();
   ImageGeometry geometry = layout.geometry;
   x.frame = applyGeometryOptions(o.input, geometry, x.frame);
-  const WithGeometry source(makeChunkedSource(cache), geometry);
+  const std::unique_ptr<VoxelSource> chunked = makeChunkedSource(cache, geometry);
+  const VoxelSource& source = *chunked;
   clock.lap(x.timings, "read");
   x.input = o.input.path;
   x.dims = layout.dims;
@@ -63,6 +44,41 @@ void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progr
 
 }  // namespace
 
+/// `mesh STORE --all --iso S --dask ADDRESS`: every boundary by blocks on Dask, the same file as
+/// the single pass (DaskJob.h); the summary gives the driver's figures.
+static int meshAllOnDask(const MeshOptions& o, bool binary) {
+  ImageGeometry g;
+  nlohmann::json job = storeJob(o.input, o.dask, o.block, o.workDir, g);
+  job["kind"] = "threshold";
+  job["iso"] = *o.surface.iso;
+  job["mapping"] = o.surface.mapping == MappingMode::Midpoint ? "midpoint" : "linear";
+  job["adjacency"] = toString(o.surface.pair);
+  const std::string output = std::filesystem::absolute(o.output).string();
+  job["output"] = output;
+  job["binary"] = binary;
+  job["quiet"] = o.out.quiet;
+  const StageClock clock;
+  const nlohmann::json r = runDaskJob(job, output, "");
+  nlohmann::ordered_json j;
+  j["input"] = o.input.path;
+  j["output"] = o.output;
+  j["dask"] = o.dask;
+  j["vertices"] = r["vertices"];
+  j["triangles"] = r["triangles"];
+  j["boundaries"] = r["boundaries"];
+  j["euler_characteristic"] = r["euler"];
+  j["seconds"] = number(clock.total());
+  if (o.out.json) {
+    std::cout << jsonText(j) << std::endl;
+  } else if (!o.out.quiet) {
+    std::cout << "surftrack: " << o.input.path << " -> " << o.output << " (by blocks on Dask, " << o.dask << ")\n"
+              << "  mesh        " << r["boundaries"] << " boundaries, " << r["vertices"] << " vertices, "
+              << r["triangles"] << " triangles, Euler characteristic " << r["euler"] << "\n"
+              << "  time        " << num(clock.total(), 3) << " s\n";
+  }
+  return 0;
+}
+
 int runMesh(const std::vector<std::string>& args) {
   const MeshOptions o = parseMeshOptions(args);
   Extraction x;
@@ -71,6 +87,7 @@ int runMesh(const std::vector<std::string>& args) {
   x.binary = !o.ascii && (x.format == "ply" || x.format == "stl");
   requireWritable(o.output);        // fail now rather than after the work
   requireNotInput(o.output, o.input.path);
+  if (!o.dask.empty()) return meshAllOnDask(o, x.binary);
 
   Progress progress(Progress::wanted(o.out.quiet));
   StageClock clock;

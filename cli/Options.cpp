@@ -422,9 +422,39 @@ const char* const kInfoSummary = "describe a volume: size, type, geometry, value
 const char* const kDemoSummary =
     "extract surfaces of a built-in phantom (and of the\nmricron-data MRI volumes when installed)";
 
+/// --dask, --block, --work-dir (labels, and mesh --all): the block meshing of a chunked store.
+void addDaskOptions(CLI::App& app, std::string& dask, std::string& block, std::string& workDir,
+                    const std::string& group, const std::string& same) {
+  app.add_option("--dask", dask, "local:N (N worker processes here) or a Dask scheduler's address\n"
+                 "(tcp://host:8786): " + same + ", each\nblock meshed by a worker, no volume in one memory (docs/cli.md)")
+      ->option_text("ADDRESS")
+      ->group(group);
+  app.add_option("--block", block, "the blocks' size in voxels (default 256,256,256)")
+      ->option_text("BX,BY,BZ")
+      ->check(tripleOf({kInteger, explained(CLI::Range(1LL, kMaxDim), "a block size is 1 to 524285 voxels")},
+                       "expected three integers BX,BY,BZ"))
+      ->group(group);
+  app.add_option("--work-dir", workDir, "where the blocks' fragment files go, seen by every worker\n"
+                 "(default: a temporary directory); kept, so that a run again resumes")
+      ->option_text("DIR")
+      ->group(group);
+}
+
+/// The --block of addDaskOptions, checked against --dask.
+void parseDaskOptions(const std::string& dask, const std::string& blockText, const std::string& workDir,
+                      std::array<int, 3>& block) {
+  if (!blockText.empty()) {
+    const auto parts = splitCommas(blockText);
+    for (int k = 0; k < 3; ++k) block[std::size_t(k)] = int(*toInteger(parts[std::size_t(k)]));
+  }
+  if (dask.empty() && (!blockText.empty() || !workDir.empty()))
+    throw UsageError("--block and --work-dir are for --dask");
+}
+
 struct MeshArgs {
   InputArgs input;
   std::vector<const CLI::Option*> seedRules;  ///< --seed, --seed-point, --largest, --all
+  std::string block;                          ///< --block BX,BY,BZ
   CLI::Option* largest = nullptr;
   CLI::Option* all = nullptr;
   CLI::Option* mapping = nullptr;
@@ -549,6 +579,8 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
       }))
       ->group(refine);
 
+  addDaskOptions(app, o.dask, a.block, o.workDir, "by blocks on Dask (a chunked store, --all --iso S)",
+                 "the same file as the single pass");
   a.input = addInputOptions(app, o.input);
   addOutputOptions(app, o.out);
   addHelp(app);
@@ -632,6 +664,7 @@ void parseLabelList(const std::string& text, LabelsOptions& o) {
 struct LabelsArgs {
   std::string labels;               ///< --labels, parsed by parseLabelList
   std::vector<std::string> seeds;   ///< --seed, each x,y,z
+  std::string block;                ///< --block BX,BY,BZ
   InputArgs input;
 };
 
@@ -690,6 +723,8 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
       ->option_text("W")
       ->check(CLI::IsMember({"independent", "shared"}))
       ->group(which);
+  addDaskOptions(app, o.dask, args.block, o.workDir, "by blocks on Dask (a chunked store, -o DIR/)",
+                 "the same files and table as the single pass");
   addSurfaceOptions(app, o.pair, o.ascii, o.threads,
                     "threads for the scan and the labels (default 0: all cores);\n"
                     "the meshes are the same for any number");
@@ -744,6 +779,11 @@ MeshOptions parseMeshOptions(const std::vector<std::string>& args) {
   if (o.surface.iso && o.surface.label) throw UsageError("give --iso or --label, not both");
   if (o.surface.label && o.surface.mapping == MappingMode::Linear)
     throw UsageError("--mapping linear interpolates an iso-value: it needs --iso, not --label");
+  parseDaskOptions(o.dask, a.block, o.workDir, o.block);
+  if (!o.dask.empty() && (o.surface.seedMode != SeedMode::All || !o.surface.iso || o.surface.refine.smoothIterations > 0 ||
+                          o.surface.refine.maxError || o.surface.refine.reduction))
+    throw UsageError("--dask meshes every boundary of a threshold: give --all and --iso S (not --label, a seed "
+                     "rule, Otsu's default, --smooth or decimation)");
   checkRaw(o.input, a.input);
   return o;
 }
@@ -785,6 +825,10 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
     o.seeds.push_back(Voxel{int(*toInteger(parts[0])), int(*toInteger(parts[1])), int(*toInteger(parts[2]))});
   }
   if (o.largest && !o.seeds.empty()) throw UsageError("give --largest or --seed, not both");
+  parseDaskOptions(o.dask, a.block, o.workDir, o.block);
+  if (!o.dask.empty() && (o.largest || !o.seeds.empty() || !o.labels.empty() || o.range || !o.format.empty()))
+    throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest, "
+                     "--seed or --format yet");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
   if (!o.unit.empty() && o.format != "precomputed") throw UsageError("--unit is for --format precomputed");
   if (o.format == "precomputed" && (o.output.find('{') != std::string::npos ||

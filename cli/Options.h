@@ -77,6 +77,10 @@ struct MeshOptions {
   std::string output;   ///< -o: .ply, .obj, .off or .stl
   bool ascii = false;   ///< --ascii: text PLY / STL
   int cacheMiB = 512;   ///< --cache: decoded chunks kept when a chunked store is read lazily
+  /// --dask ADDRESS with --all: every boundary of a chunked store by blocks on Dask (as labels').
+  std::string dask;
+  std::array<int, 3> block{256, 256, 256};  ///< --block BX,BY,BZ (with --dask)
+  std::string workDir;                      ///< --work-dir DIR (with --dask)
   OutputOptions out;
 };
 
@@ -115,6 +119,11 @@ struct LabelsOptions {
   /// instead of one mesh file per label.
   std::string format;
   std::string unit;   ///< --unit U: the physical unit of the volume's spacing (precomputed output)
+  /// --dask ADDRESS: a chunked store meshed by blocks on Dask (cli/DaskLabels.h): "local:N" or a
+  /// scheduler's address ("tcp://host:8786"); empty: the single pass.
+  std::string dask;
+  std::array<int, 3> block{256, 256, 256};  ///< --block BX,BY,BZ (with --dask)
+  std::string workDir;                      ///< --work-dir DIR (with --dask): fragments kept, a run resumes
   OutputOptions out;
 };
 

@@ -61,6 +61,8 @@ class StagedOutputs {
   std::string temporaryFor(const std::string& target);
   /// Moves every output into place.
   void commit();
+  /// The hidden directory the outputs of inDirectory() are written into ("" otherwise).
+  const std::string& stagingDirectory() const { return staging_; }
 
  private:
   std::string directory_, staging_;

@@ -390,7 +390,7 @@ json extractionJson(const Extraction& x) {
 }
 
 void printVolumeInfo(std::ostream& out, const std::string& path, const io::LoadedVolume& volume,
-                     const VolumeStats& s) {
+                     const VolumeStats* stats, const io::ChunkedStore* store, const std::string& notRead) {
   const Dims& d = volume.view.dims;
   const ImageGeometry& g = volume.view.geometry;
   out << "surftrack: " << path << "\n";
@@ -403,6 +403,21 @@ void printVolumeInfo(std::ostream& out, const std::string& path, const io::Loade
     row(out, "channel", std::to_string(volume.channel) + " of channels 0 to " + std::to_string(volume.channels - 1));
   std::array<double, 3> far = g.toPhysical({double(d.nx - 1), double(d.ny - 1), double(d.nz - 1)});
   row(out, "extent", "voxel centres from " + tripleText(g.origin) + " to " + tripleText(far));
+  if (store) {
+    const ChunkLayout& l = store->provider->layout();
+    const Dims n = l.chunkCounts();
+    std::string c = std::to_string(l.chunk.nx) + " x " + std::to_string(l.chunk.ny) + " x " +
+                    std::to_string(l.chunk.nz) + " voxels, " + std::to_string(n.nx) + " x " + std::to_string(n.ny) +
+                    " x " + std::to_string(n.nz) + " = " + std::to_string(n.count()) + " chunks, " + store->dtype +
+                    ", compressor " + store->compressor;
+    row(out, "chunks", c);
+    if (!store->choiceText().empty()) row(out, "chosen", store->choiceText());
+  }
+  if (!stats) {
+    row(out, "storage", volume.format + ", its values not read: " + notRead);
+    return;
+  }
+  const VolumeStats& s = *stats;
   row(out, "storage", storageText(volume));
   {
     std::ostringstream v;
@@ -433,7 +448,8 @@ void printVolumeInfo(std::ostream& out, const std::string& path, const io::Loade
   }
 }
 
-json volumeJson(const std::string& path, const io::LoadedVolume& volume, const VolumeStats& s) {
+json volumeJson(const std::string& path, const io::LoadedVolume& volume, const VolumeStats* stats,
+                const io::ChunkedStore* store, const std::string& notRead) {
   const Dims& d = volume.view.dims;
   const ImageGeometry& g = volume.view.geometry;
   json j;
@@ -448,6 +464,18 @@ json volumeJson(const std::string& path, const io::LoadedVolume& volume, const V
   j["direction"] = directionJson(g);
   j["channel"] = volume.channel;
   j["channels"] = volume.channels;
+  if (store) {
+    const ChunkLayout& l = store->provider->layout();
+    const Dims n = l.chunkCounts();
+    j["chunked"] = {{"format", store->format}, {"array", store->arrayPath}, {"dtype", store->dtype},
+                    {"compressor", store->compressor}, {"chunk", {l.chunk.nx, l.chunk.ny, l.chunk.nz}},
+                    {"chunks", {n.nx, n.ny, n.nz}}, {"level", store->level}, {"levels", store->levels}};
+  }
+  if (!stats) {
+    j["storage"] = {{"format", volume.format}, {"values_read", false}, {"not_read_because", notRead}};
+    return j;
+  }
+  const VolumeStats& s = *stats;
   j["storage"] = storageJson(volume);
   j["min"] = number(s.min);
   j["max"] = number(s.max);

@@ -19,11 +19,15 @@ void printSummary(std::ostream& out, const Extraction& x);
 /// The extraction as one JSON object (keys in the order written; `demo` puts it in an array).
 nlohmann::ordered_json extractionJson(const Extraction& x);
 
-/// `surftrack info`: the description of a volume.
+/// `surftrack info`: the description of a volume. `stats` null: its values were not read
+/// (`notRead` says why: a chunked store too large to decode whole; dims, type and geometry are
+/// then the store's metadata). `store`: the chunked store it came from (its chunks, codec,
+/// levels), or null.
 void printVolumeInfo(std::ostream& out, const std::string& path, const io::LoadedVolume& volume,
-                     const VolumeStats& stats);
+                     const VolumeStats* stats, const io::ChunkedStore* store, const std::string& notRead = {});
 nlohmann::ordered_json volumeJson(const std::string& path, const io::LoadedVolume& volume,
-                                  const VolumeStats& stats);
+                                  const VolumeStats* stats, const io::ChunkedStore* store,
+                                  const std::string& notRead = {});
 
 /// The text --json prints: indented by 2, one value per line, invalid UTF-8 in strings (a
 /// file name) replaced by U+FFFD.

@@ -588,6 +588,13 @@ def test_cli_meshes_a_store_as_the_same_voxels_in_a_raw_file(tmp_path):
     info = json.loads(r.stdout)
     assert info["dims"] == [32, 36, 40] and info["unit"] == "micrometer" and info["channel"] == 1
     assert info["spacing"] == [0.5, 1.0, 2.0] and info["origin"] == [5.0, -4.0, 3.0]
+    # The store's chunks as zarr-python states them (its axes reversed: the engine's x first).
+    level0 = zarr.open(str(store / "s0"), mode="r")
+    chunked = info["chunked"]
+    assert chunked["chunk"] == list(level0.chunks[1:][::-1]) and chunked["levels"] == 2 and chunked["level"] == 0
+    assert chunked["chunks"] == [-(-n // c) for n, c in zip(level0.shape[1:][::-1], level0.chunks[1:][::-1])]
+    assert chunked["dtype"] == level0.dtype.str and chunked["format"] == "ome-zarr"
+    assert info["storage"]["mapped"] is False and "min" in info  # (small: its values read)
     for args, says in [((store, "--level", 2), "level 2 is outside its 2 levels"),
                        ((store, "--time", 0), "no time axis"),
                        ((tmp_path / "ball.raw", "--raw-dims", "1,1,1", "--raw-type", "uint8", "--level", 1), "--level and --time")]:
@@ -666,6 +673,19 @@ def test_a_store_larger_than_memory_is_read_lazily_or_refused(tmp_path):
     assert r.returncode == 1 and r.stderr.count("\n") == 1, r.stderr
     assert "whole" in r.stderr and "seed rule" in r.stderr and "surftrack.distributed" in r.stderr
     assert not (tmp_path / "b.ply").exists()
+    # `info` describes it from its metadata, decoding nothing: a chunk made garbage is not read.
+    for chunk in store.glob("1.*"):
+        chunk.write_bytes(b"garbage")
+    r = surftrack("info", store, "--json")
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout)
+    assert info["dims"] == [4000, 4000, 4000] and info["type"] == "uint8" and "min" not in info
+    assert info["storage"]["values_read"] is False and "memory" in info["storage"]["not_read_because"]
+    assert info["chunked"]["chunk"] == [64, 64, 64] and info["chunked"]["chunks"] == [63, 63, 63]
+    assert info["chunked"]["compressor"].startswith("blosc")  # zarr-python's default compressor
+    r = surftrack("info", store, "--spacing", "2,3,4")
+    assert r.returncode == 0 and "its values not read" in r.stdout and "63 x 63 x 63 = 250047 chunks" in r.stdout
+    assert "voxel centres from (0, 0, 0) to (7998, 11997, 15996)" in r.stdout, r.stdout
 
 
 MUTANTS = [None, 0, -1, 1, 3, 2 ** 31, 2 ** 63, -2 ** 63, 2 ** 64 - 1, 1.5, 1e300, "NaN", "", "x", [], [1], [0, 0, 0],

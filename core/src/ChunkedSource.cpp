@@ -5,6 +5,7 @@
 // image returns 0 for every voxel outside its chunk, so the rows of the chunks OR together into
 // the row of the whole array.
 #include <algorithm>
+#include <cstring>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -243,11 +244,11 @@ ChunkRange chunksOf(int lo, int hi, int chunk) { return {lo / chunk, (hi - 1) / 
 template <class T>
 class ChunkedSource final : public VoxelSource {
  public:
-  explicit ChunkedSource(std::shared_ptr<const ChunkCache> cache)
-      : cache_(std::move(cache)), layout_(cache_->layout()) {}
+  ChunkedSource(std::shared_ptr<const ChunkCache> cache, const ImageGeometry& geometry)
+      : cache_(std::move(cache)), layout_(cache_->layout()), geometry_(geometry) {}
 
   Dims dims() const override { return layout_.dims; }
-  ImageGeometry geometry() const override { return layout_.geometry; }
+  ImageGeometry geometry() const override { return geometry_; }
   ScalarType type() const override { return scalarTypeOf<T>(); }
 
   void binaryBlock(const Selection& selection, Voxel origin, int width, int ny, int nz,
@@ -358,14 +359,53 @@ class ChunkedSource final : public VoxelSource {
 
   std::shared_ptr<const ChunkCache> cache_;
   ChunkLayout layout_;
+  ImageGeometry geometry_;
 };
 
 }  // namespace
 
-std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache) {
+void copyBox(const ChunkCache& cache, Voxel lo, Dims extent, void* out) {
+  const ChunkLayout& layout = cache.layout();
+  for (int a = 0; a < 3; ++a)
+    if (lo[a] < 0 || extent[a] < 1 || std::int64_t(lo[a]) + extent[a] > layout.dims[a])
+      throw InvalidInput("the box from (" + std::to_string(lo.x) + ", " + std::to_string(lo.y) + ", " +
+                         std::to_string(lo.z) + ") of " + std::to_string(extent.nx) + " x " +
+                         std::to_string(extent.ny) + " x " + std::to_string(extent.nz) +
+                         " voxels is not inside the array");
+  const std::size_t item = sizeOf(layout.type);
+  const ChunkRange cx = chunksOf(lo.x, lo.x + extent.nx, layout.chunk.nx),
+                   cy = chunksOf(lo.y, lo.y + extent.ny, layout.chunk.ny),
+                   cz = chunksOf(lo.z, lo.z + extent.nz, layout.chunk.nz);
+  auto* to = static_cast<unsigned char*>(out);
+  for (int iz = cz.first; iz <= cz.last; ++iz)
+    for (int iy = cy.first; iy <= cy.last; ++iy)
+      for (int ix = cx.first; ix <= cx.last; ++ix) {
+        const std::shared_ptr<const DecodedChunk> c = cache.chunk({ix, iy, iz});
+        const auto* from = static_cast<const unsigned char*>(c->data);
+        Voxel a, b;  // the part of the box in this chunk, in array coordinates
+        for (int k = 0; k < 3; ++k) {
+          a[k] = std::max(lo[k], c->origin[k]);
+          b[k] = std::min(lo[k] + extent[k], c->origin[k] + c->extent[k]);
+        }
+        const std::size_t run = std::size_t(b.x - a.x) * item;
+        for (int z = a.z; z < b.z; ++z)
+          for (int y = a.y; y < b.y; ++y) {
+            const std::size_t src = ((std::size_t(z - c->origin.z) * std::size_t(c->extent.ny) +
+                                      std::size_t(y - c->origin.y)) * std::size_t(c->extent.nx) +
+                                     std::size_t(a.x - c->origin.x)) * item;
+            const std::size_t dst = ((std::size_t(z - lo.z) * std::size_t(extent.ny) + std::size_t(y - lo.y)) *
+                                         std::size_t(extent.nx) + std::size_t(a.x - lo.x)) * item;
+            std::memcpy(to + dst, from + src, run);
+          }
+      }
+}
+
+std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache,
+                                               std::optional<ImageGeometry> geometry) {
   if (!cache) throw InvalidInput("the chunked source has no chunk cache (null pointer)");
+  const ImageGeometry g = geometry.value_or(cache->layout().geometry);
   return visitScalarType(cache->layout().type, [&](auto v) -> std::unique_ptr<VoxelSource> {
-    return std::make_unique<ChunkedSource<decltype(v)>>(cache);
+    return std::make_unique<ChunkedSource<decltype(v)>>(cache, g);
   });
 }
 

@@ -23,6 +23,9 @@
 #include <surftrack/ThresholdBlocks.h>
 
 #include "ChunkedSource.h"
+#include <OpenMesh/Core/System/omstream.hh>
+
+#include "ArrayChunkProvider.h"
 #include "ChunkedStore.h"  // io/: zarr, OME-Zarr, N5
 #include "ReadVolume.h"    // io/: ReadError
 #include "PrecomputedMesh.h"  // converter/: Neuroglancer's format
@@ -395,31 +398,18 @@ py::dict extractArray(py::array volume, std::array<int, 3> order, const std::str
                      maxError, reduction, maxSeedDistance);
 }
 
-/// A source whose voxels are another's and whose geometry is given (a store's geometry
-/// replaced by the caller's spacing, origin, direction).
-class SourceWithGeometry final : public VoxelSource {
- public:
-  SourceWithGeometry(const VoxelSource& source, const ImageGeometry& geometry) : source_(source), geometry_(geometry) {}
-  Dims dims() const override { return source_.dims(); }
-  ImageGeometry geometry() const override { return geometry_; }
-  ScalarType type() const override { return source_.type(); }
-  void binaryBlock(const Selection& s, Voxel origin, int width, int ny, int nz, std::uint16_t* out) const override {
-    source_.binaryBlock(s, origin, width, ny, nz, out);
-  }
-  std::uint64_t binaryRow(const Selection& s, Voxel start, int count) const override {
-    return source_.binaryRow(s, start, count);
-  }
-  void values(const Voxel* voxels, std::size_t n, double* out) const override { source_.values(voxels, n, out); }
+/// What a chunk cache did, as Surface.chunks.
+py::dict chunkFigures(const ChunkCache& cache) {
+  const ChunkCacheCounters c = cache.counters();
+  const Dims n = cache.layout().chunkCounts();
+  py::dict chunks;
+  chunks["chunks"] = std::uint64_t(n.nx) * std::uint64_t(n.ny) * std::uint64_t(n.nz);
+  chunks["decoded"] = c.chunksDecoded;
+  chunks["bytes_read"] = c.bytesRead;
+  chunks["hits"] = c.hits;
+  return chunks;
+}
 
- private:
-  const VoxelSource& source_;
-  ImageGeometry geometry_;
-};
-
-/// extract() from the chunked store at `path` (zarr, OME-Zarr, N5: io/ChunkedStore.h), read
-/// lazily through a cache of `cacheBytes` (ChunkedSource.h); engine x is the array's last axis.
-/// `spacing`, `origin`, `direction` (array axes) replace the store's geometry when given. The
-/// dict has the surface's fields and "chunks" (chunks in the store, decoded, bytes read, hits).
 py::dict extractStore(const std::string& path, int level, std::optional<std::int64_t> channel,
                       std::optional<std::int64_t> time, std::size_t cacheBytes, const std::string& selectionKind,
                       py::object value, const std::string& seedKind, std::array<double, 6> seed,
@@ -439,10 +429,9 @@ py::dict extractStore(const std::string& path, int level, std::optional<std::int
     throw py::value_error(e.what());
   }
   const auto cache = std::make_shared<const ChunkCache>(store.provider, cacheBytes);
-  const std::unique_ptr<VoxelSource> chunked = makeChunkedSource(cache);
   // Python's coordinates follow the array's axes (z, y, x for a store): the store's physical
   // rows (x, y, z) reversed.
-  const ImageGeometry stored = chunked->geometry();
+  const ImageGeometry stored = cache->layout().geometry;
   ImageGeometry g = stored;
   for (int k = 0; k < 3; ++k) {
     g.origin[k] = stored.origin[2 - k];
@@ -455,7 +444,8 @@ py::dict extractStore(const std::string& path, int level, std::optional<std::int
       for (int k = 0; k < 3; ++k) g.direction[k][e] = (*direction)[k][a];
   }
   if (origin) g.origin = *origin;
-  const SourceWithGeometry source(*chunked, g);
+  const std::unique_ptr<VoxelSource> chunked = makeChunkedSource(cache, g);
+  const VoxelSource& source = *chunked;
   py::dict out;
   try {
     out = extractWith([&](const ExtractOptions& o) { return extract(source, o); }, kLastAxisFirst, selectionKind,
@@ -464,14 +454,95 @@ py::dict extractStore(const std::string& path, int level, std::optional<std::int
   } catch (const io::ReadError& e) {
     throw py::value_error(e.what());  // a chunk that cannot be decoded
   }
-  const ChunkCacheCounters c = cache->counters();
-  const Dims n = cache->layout().chunkCounts();
-  py::dict chunks;
-  chunks["chunks"] = std::uint64_t(n.nx) * std::uint64_t(n.ny) * std::uint64_t(n.nz);
-  chunks["decoded"] = c.chunksDecoded;
-  chunks["bytes_read"] = c.bytesRead;
-  chunks["hits"] = c.hits;
-  out["chunks"] = chunks;
+  out["chunks"] = chunkFigures(*cache);
+  return out;
+}
+
+/// extract() on an array that only Python reads (python/src/ArrayChunkProvider.h): `shape`
+/// and `chunks` in the array's axes [z, y, x], `dtype` the native type each slice becomes;
+/// spacing, origin and direction as extractArray's.
+py::dict extractChunked(py::object array, std::array<std::int64_t, 3> shape, std::array<std::int64_t, 3> chunks,
+                        py::dtype dtype, std::size_t cacheBytes, const std::string& selectionKind,
+                        py::object value, const std::string& seedKind, std::array<double, 6> seed,
+                        const std::string& adjacency, const std::string& mapping, double epsilon,
+                        std::array<double, 3> spacing, std::array<double, 3> origin,
+                        std::array<std::array<double, 3>, 3> direction, int threads, bool figures,
+                        py::object progress, int smoothIterations, std::optional<double> maxError,
+                        std::optional<double> reduction, double maxSeedDistance) {
+  ChunkLayout layout;
+  layout.type = scalarTypeOfDtype(dtype);
+  for (int e = 0; e < 3; ++e) {
+    const int a = kLastAxisFirst[e];
+    if (shape[a] < 1 || shape[a] > kMaxDimension)
+      throw py::value_error("volume shape: each dimension must be 1 to " + std::to_string(kMaxDimension));
+    if (chunks[a] < 1) throw py::value_error("chunk shape: each dimension must be at least 1");
+    (e == 0 ? layout.dims.nx : e == 1 ? layout.dims.ny : layout.dims.nz) = int(shape[a]);
+    (e == 0 ? layout.chunk.nx : e == 1 ? layout.chunk.ny : layout.chunk.nz) = int(std::min(chunks[a], shape[a]));
+    layout.geometry.spacing[e] = spacing[a];
+    for (int k = 0; k < 3; ++k) layout.geometry.direction[k][e] = direction[k][a];
+  }
+  layout.geometry.origin = origin;
+  const auto provider = std::make_shared<const python::ArrayChunkProvider>(std::move(array), layout, dtype);
+  const auto cache = std::make_shared<const ChunkCache>(provider, cacheBytes);
+  const std::unique_ptr<VoxelSource> source = makeChunkedSource(cache);
+  py::dict out;
+  try {
+    out = extractWith([&](const ExtractOptions& o) { return extract(*source, o); }, kLastAxisFirst, selectionKind,
+                      value, seedKind, seed, adjacency, mapping, epsilon, threads, figures, progress,
+                      smoothIterations, maxError, reduction, maxSeedDistance);
+  } catch (const io::ReadError& e) {
+    throw py::value_error(e.what());  // a slice that failed or came back wrong
+  }
+  out["chunks"] = chunkFigures(*cache);
+  return out;
+}
+
+/// The chunked store at `path` (its level, channel and time chosen), for the block tasks of the
+/// command line's --dask (python/surftrack/_cli_dask.py).
+io::ChunkedStore openStore(const std::string& path, int level, std::optional<std::int64_t> channel,
+                           std::optional<std::int64_t> time) {
+  io::ChunkedStoreOptions chosen;
+  chosen.level = level;
+  chosen.channel = channel;
+  chosen.time = time;
+  try {
+    return io::openChunkedStore(path, chosen);
+  } catch (const io::ReadError& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+/// numpy's name of a voxel type, native byte order (toString's but for the float types, which
+/// numpy would read as float64 both).
+std::string dtypeName(ScalarType type) {
+  return type == ScalarType::Float32 ? "float32" : type == ScalarType::Float64 ? "float64" : toString(type);
+}
+
+/// (shape [z, y, x], dtype name) of a store's chosen array.
+py::tuple storeLayout(const std::string& path, int level, std::optional<std::int64_t> channel,
+                      std::optional<std::int64_t> time) {
+  const ChunkLayout& l = openStore(path, level, channel, time).provider->layout();
+  return py::make_tuple(py::make_tuple(l.dims.nz, l.dims.ny, l.dims.nx), dtypeName(l.type));
+}
+
+/// The voxels [lo, hi) (array axes [z, y, x]) of a store's chosen array, each chunk decoded once.
+py::array readStoreBox(const std::string& path, int level, std::optional<std::int64_t> channel,
+                       std::optional<std::int64_t> time, std::array<int, 3> lo, std::array<int, 3> hi) {
+  const io::ChunkedStore store = openStore(path, level, channel, time);
+  const ChunkCache cache(store.provider, 0);  // (copyBox visits each chunk once)
+  const Voxel at{lo[2], lo[1], lo[0]};
+  const Dims extent{hi[2] - lo[2], hi[1] - lo[1], hi[0] - lo[0]};
+  py::array out(py::dtype(dtypeName(store.provider->layout().type)),
+                {py::ssize_t(std::max(extent.nz, 0)), py::ssize_t(std::max(extent.ny, 0)), py::ssize_t(std::max(extent.nx, 0))});
+  void* data = out.mutable_data();
+  try {
+    py::gil_scoped_release release;
+    copyBox(cache, at, extent, data);
+  } catch (const io::ReadError& e) {
+    throw py::value_error(e.what());
+  } catch (const InvalidInput& e) {
+    throw py::value_error(e.what());
+  }
   return out;
 }
 
@@ -749,6 +820,11 @@ void writePrecomputed(const py::list& segments, const std::string& path, std::ar
 
 PYBIND11_MODULE(_surftrack, m) {
   m.doc() = "surftrack's C++ front door (see surftrack.extract)";
+  // OpenMesh's writers log to stderr ("[OBJWriter] : write file"); errors reach Python as
+  // exceptions with their own one-line messages, as in the CLI (cli/main.cpp).
+  omerr().disable();
+  omlog().disable();
+  omout().disable();
   py::register_exception<InvalidInput>(m, "InvalidInput", PyExc_ValueError);
   py::register_exception<InternalError>(m, "InternalError", PyExc_RuntimeError);
   py::register_exception<Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);
@@ -773,6 +849,9 @@ PYBIND11_MODULE(_surftrack, m) {
       .def("surfels", &Result::surfels);
   m.def("extract_array", &extractArray);
   m.def("extract_store", &extractStore);
+  m.def("extract_chunked", &extractChunked);
+  m.def("store_layout", &storeLayout);
+  m.def("read_store_box", &readStoreBox);
   m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
   m.def("write_precomputed", &writePrecomputed);

@@ -129,6 +129,49 @@ def _store_path(volume) -> Optional[str]:
     return None
 
 
+#: The chunk side used for an array-like that states no chunks (an h5py dataset stored
+#: contiguously): each read is one slice of this many voxels a side.
+_DEFAULT_SLICE = 64
+
+
+def _sliced_array(volume):
+    """(shape, chunks, dtype) of an array the engine reads slice by slice through Python (a dask
+    array, an h5py dataset, a zarr array not on a directory: anything not numpy with ``.shape``,
+    ``.dtype``, ``.chunks`` and slicing); None for anything else. ``chunks`` per axis is the
+    array's chunk side (dask's first block along the axis), or _DEFAULT_SLICE when it states
+    none; ``dtype`` the native type each slice is converted to (bool as uint8)."""
+    if isinstance(volume, np.ndarray) or not all(hasattr(volume, a) for a in ("shape", "dtype", "chunks",
+                                                                               "__getitem__")):
+        return None
+    shape = tuple(int(n) for n in volume.shape)
+    dtype = np.dtype(volume.dtype)
+    if len(shape) != 3:
+        raise ValueError(f"the volume must be 3-D, not {len(shape)}-D")
+    if dtype.kind not in "biuf":
+        raise TypeError(f"unsupported volume dtype '{dtype}': expected bool, "
+                        "uint8/16/32/64, int8/16/32/64, float32 or float64")
+    if min(shape) == 0:
+        raise ValueError(f"the volume is empty (shape {shape})")
+    chunks = volume.chunks
+    if chunks is None:
+        chunks = (_DEFAULT_SLICE,) * 3
+    chunks = tuple(int(c[0]) if isinstance(c, tuple) else int(c) for c in chunks)
+    if len(chunks) != 3 or min(chunks) < 1:
+        raise ValueError(f"the array's chunks {volume.chunks!r} are not three positive sizes")
+    dtype = np.dtype(np.uint8) if dtype.kind == "b" else dtype.newbyteorder("=")
+    return shape, chunks, dtype
+
+
+def _chunked_surface(out: dict) -> Surface:
+    """The Surface of an extraction read chunk by chunk, with what its cache did."""
+    chunks = out.pop("chunks")
+    surface = Surface(**out)
+    surface.chunks = chunks
+    for message in surface.warnings:
+        _warnings.warn(message, stacklevel=3)
+    return surface
+
+
 def _as_volume(volume) -> np.ndarray:
     """The volume as an array the engine reads in place; checked before any voxel is read (a
     broadcast array can have a vast shape over a single value)."""
@@ -259,8 +302,12 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
             raise ValueError("a chunked store needs level= or label=: the default level, the middle "
                              "of the data range, would read every chunk")
         array = None
+        sliced = None
     else:
-        array = _as_volume(volume)
+        # An array-like read through Python: slice by slice when the extraction reads near its
+        # surface only (a seed, with a level or a label), whole otherwise (as before).
+        sliced = _sliced_array(volume) if mode == "seed" and (level is None) != (label is None) else None
+        array = None if sliced is not None else _as_volume(volume)
     if affine is not None:
         spacing, origin, direction = _split_affine(affine)
     if (level is None) == (label is None):
@@ -325,12 +372,15 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
             None if np.array_equal(direction, np.eye(3)) else direction.tolist(), int(threads), bool(figures),
             progress, int(smooth), None if max_error is None else float(max_error),
             None if reduce is None else float(reduce), float(max_seed_distance))
-        chunks = out.pop("chunks")
-        surface = Surface(**out)
-        surface.chunks = chunks
-        for message in surface.warnings:
-            _warnings.warn(message, stacklevel=2)
-        return surface
+        return _chunked_surface(out)
+    if sliced is not None:
+        shape, chunk_shape, dtype = sliced
+        out = _surftrack.extract_chunked(
+            volume, list(shape), list(chunk_shape), dtype, int(cache_mib) << 20, kind, value, seed_kind,
+            seed_values, adjacency, mapping, float(epsilon), spacing, origin, direction.tolist(), int(threads),
+            bool(figures), progress, int(smooth), None if max_error is None else float(max_error),
+            None if reduce is None else float(reduce), float(max_seed_distance))
+        return _chunked_surface(out)
     if seed_kind in ("largest", "all") and not array.flags.c_contiguous:
         # The scan reads every voxel row by row: one C-ordered copy is faster than reading
         # across memory, and it is read once anyway (a seeded extraction never copies).

@@ -1,5 +1,6 @@
 """Every label of a volume larger than one machine, by blocks on Dask (docs/python.md, "Every
-label by blocks, on Dask"; the proof of exactness is docs/theory.md, "Label maps by blocks").
+label by blocks, on Dask"; the proof of exactness is docs/theory.md, "Label maps by blocks"),
+and every boundary of a threshold the same way (docs/theory.md, "Thresholds by blocks").
 
 A block owns the cubes whose minimum corner lies in its core and reads one more voxel on its
 high sides; each of its labels' fragments holds global surfel keys and the triangles of the cubes
@@ -20,6 +21,7 @@ import itertools
 import os
 import tempfile
 import uuid
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -40,8 +42,15 @@ def block_grid(shape, block):
     return [(tuple(a[0] for a in c), tuple(a[1] for a in c)) for c in itertools.product(*axes)]
 
 
-def _fragment_path(work_dir, lo):
-    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}.npz"
+def _fragment_path(work_dir, lo, run):
+    """The fragment file of the block at `lo` in a run: `run` names what the fragments depend on
+    (the kind of run, the array's shape and type, the block size, the selection, the pair), so
+    that a work_dir reused with other arguments recomputes rather than reuses."""
+    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}_{run}.npz"
+
+
+def _run_name(*what):
+    return f"{zlib.crc32(repr(what).encode()):08x}"
 
 
 def _summary(path):
@@ -52,10 +61,10 @@ def _summary(path):
     return {L: (int(k), int(t)) for L, k, t in zip(labels, keys, tris)}
 
 
-def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir):
+def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir, run):
     """Task: the fragments of one block, written to its file (atomically: a retried or repeated
     task writes the same bytes; an existing file is kept, so a resumed run skips the block)."""
-    path = _fragment_path(work_dir, lo)
+    path = _fragment_path(work_dir, lo, run)
     if path.exists():
         return str(path), _summary(path)
     top = [min(h + 1, n) for h, n in zip(hi, shape)]  # the one-voxel apron on the high sides
@@ -75,91 +84,166 @@ def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir):
     return str(path), {f[0]: (len(f[2]), len(f[3])) for f in fragments}
 
 
+#: Fragment bytes a reduce task holds at most (about): the plan makes more shards than asked
+#: for when the fragments would exceed it.
+_SHARD_BYTES = 512 << 20
+
+
 def _plan(results, shards):
-    """Task: label -> its blocks' files, the labels dealt to `shards` shards by vertex count
-    (largest first, each to the lightest shard)."""
+    """Task: the labels cut into shards, each a list of (label, its blocks' files). Labels in the
+    order of their first block (neighbours together, so that a shard reads few files), cut into
+    runs of about equal fragment bytes: at least `shards` runs, and enough that none holds much
+    more than _SHARD_BYTES (a keys entry is 8 bytes, a triangle 12)."""
     where, weight = {}, {}
-    for path, summary in results:
-        for label, (keys, _) in summary.items():
-            where.setdefault(label, []).append(path)
-            weight[label] = weight.get(label, 0) + keys
-    load = [0] * shards
-    plan = [[] for _ in range(shards)]
-    for label in sorted(where, key=lambda L: (-weight[L], L)):
-        s = load.index(min(load))
-        plan[s].append((label, where[label]))
-        load[s] += weight[label]
-    return [p for p in plan if p]
+    for order, (path, summary) in enumerate(results):
+        for label, (keys, triangles) in summary.items():
+            where.setdefault(label, []).append((order, path))
+            weight[label] = weight.get(label, 0) + 8 * keys + 12 * triangles
+    labels = sorted(where, key=lambda L: (where[L][0][0], L))
+    total = sum(weight.values())
+    count = max(1, min(len(labels), max(shards, -(-total // _SHARD_BYTES))))
+    plan, run, filled = [], [], 0
+    for label in labels:
+        run.append((label, [path for _, path in where[label]]))
+        filled += weight[label]
+        if filled * count >= total * (len(plan) + 1) and len(plan) < count - 1:
+            plan.append(run)
+            run = []
+    if run:
+        plan.append(run)
+    return plan
 
 
-def _merge_label(label, paths, geometry, background, adjacency, figures):
-    fragments = []
-    for path in paths:
+def _shard_fragments(shard):
+    """(label, file) -> (voxels, keys, triangles) for every label of a shard, each file read
+    once (a label's fragments sliced out of it; the rest of the file dropped)."""
+    wanted = {}
+    for label, paths in shard:
+        for path in paths:
+            wanted.setdefault(path, set()).add(label)
+    out = {}
+    for path, labels in wanted.items():
         with np.load(path) as f:
-            i = [int(s) for s in f["labels"]].index(label)
-            k0, k1 = f["key_offsets"][i:i + 2]
-            t0, t1 = f["triangle_offsets"][i:i + 2]
-            fragments.append((int(f["voxels"][i]), f["keys"][k0:k1], f["triangles"][t0:t1]))
+            names = [int(s) for s in f["labels"]]
+            ko, to, voxels = f["key_offsets"], f["triangle_offsets"], f["voxels"]
+            keys, triangles = f["keys"], f["triangles"]
+            for i, label in enumerate(names):
+                if label in labels:
+                    out[label, path] = (int(voxels[i]), keys[ko[i]:ko[i + 1]].copy(),
+                                        triangles[to[i]:to[i + 1]].copy())
+    return out
+
+
+def _merge_label(label, fragments, geometry, background, adjacency, figures):
     spacing, origin, direction = geometry
     return _surftrack.merge_label_fragments(label, fragments, spacing, origin, direction, background,
                                             adjacency, figures)
 
 
-def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir):
-    """Task: every label of a shard merged; written as DIR/label_<L>.ply when `out_dir` is given
-    (the files only, returned as figures), else the surfaces' fields returned."""
+def _file_name(label, naming):
+    """A label's file: label_<L>.ply, or the command line's names (cli/LabelsCommand.cpp:
+    <L>_<name>.ply when the volume has label names, '/', '\\' and ' ' made '_')."""
+    if not naming or not naming["names"]:
+        return f"label_{label}.ply"
+    name = naming["names"].get(str(label), f"label{label}")
+    return f"{label}_{name.replace('/', '_').replace(' ', '_').replace(chr(92), '_')}.ply"
+
+
+def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None):
+    """Task: every label of a shard merged; written into `out_dir` (named by _file_name) when it
+    is given (the files only, returned as figures), else the surfaces' fields returned."""
     from . import Surface
     out = {}
+    fragments = _shard_fragments(shard)
     for label, paths in shard:
-        fields = _merge_label(label, paths, geometry, background, adjacency, figures)
+        fields = _merge_label(label, [fragments.pop((label, p)) for p in paths], geometry, background,
+                              adjacency, figures)
         if out_dir is None:  # plain arrays through the scheduler (the C++ result does not pickle)
             result = fields.pop("result")
             fields["surfels"], fields["normals"] = result.surfels(), result.normals()
             out[label] = fields
             continue
         surface = Surface(**fields)
-        surface.write(str(Path(out_dir) / f"label_{label}.ply"))
+        file = _file_name(label, naming)
+        surface.write(str(Path(out_dir) / file), binary=naming["binary"] if naming else True)
+        area = volume = 0.0
+        for c in surface.components:  # summed in the order the command line's table sums them
+            area += c["area"]
+            volume += c["volume"]
         out[label] = {"voxels": fields["voxels"], "vertices": len(surface.vertices),
-                      "triangles": len(surface.faces), "euler": fields["euler"]}
+                      "triangles": len(surface.faces), "euler": fields["euler"],
+                      "boundaries": len(surface.components), "area": area, "volume": volume, "file": file}
     return out
 
 
-def _run(source, *, block, spacing, origin, direction, background, adjacency, figures, client, workers,
-         work_dir, out_dir, shards, progress):
-    from dask.distributed import Client, LocalCluster, as_completed
-    from . import _geometry
+class _Cluster:
+    """The client given, or a LocalCluster of `workers` processes for the call."""
 
+    def __init__(self, client, workers):
+        self.client, self.workers, self.own = client, workers, None
+
+    def __enter__(self):
+        if self.client is None:
+            from dask.distributed import Client, LocalCluster
+            self.own = LocalCluster(n_workers=self.workers or min(os.cpu_count() or 1, 4), threads_per_worker=1,
+                                    processes=True, dashboard_address=None)
+            self.client = Client(self.own)
+        return self.client
+
+    def __exit__(self, *exc):
+        if self.own is not None:
+            self.client.close()
+            self.own.close()
+
+
+def _check_volume(source, adjacency, integers):
     shape = tuple(int(n) for n in source.shape)
     if len(shape) != 3:
-        raise ValueError(f"the label image must be 3-D, not of shape {shape}")
-    if np.dtype(source.dtype).kind not in "biu":
+        raise ValueError(f"the volume must be 3-D, not of shape {shape}")
+    if integers and np.dtype(source.dtype).kind not in "biu":
         raise ValueError(f"a label image needs integer voxels: this one has {source.dtype} voxels")
+    if not integers and np.dtype(source.dtype).kind not in "biuf":
+        raise ValueError(f"unsupported volume dtype '{source.dtype}'")
     if adjacency not in ("26-6", "18-6", "6-18", "6-26"):
         raise ValueError(f"unsupported adjacency pair '{adjacency}'")
+    return shape
+
+
+def _map_blocks(client, task, source, blocks, args, progress):
+    """Every block's task (task(source, lo, hi, *args)), waited for with progress("blocks", ...);
+    the futures in block order."""
+    from dask.distributed import as_completed
+    if isinstance(source, np.ndarray):  # sent to the workers once, not with every task
+        source = client.scatter(source, broadcast=False)
+    futures = [client.submit(task, source, lo, hi, *args,
+                             key=f"surftrack-block-{lo[0]}-{lo[1]}-{lo[2]}-{uuid.uuid4().hex[:8]}", pure=False)
+               for lo, hi in blocks]
+    done = 0
+    for _ in as_completed(futures):
+        done += 1
+        if progress:
+            progress("blocks", done, len(blocks))
+    return futures
+
+
+def _run(source, *, block, spacing, origin, direction, background, adjacency, figures, client, workers,
+         work_dir, out_dir, shards, progress, naming=None):
+    from dask.distributed import as_completed
+    from . import _geometry
+
+    shape = _check_volume(source, adjacency, integers=True)
     blocks = block_grid(shape, block)
     spacing, origin, direction = _geometry(spacing, origin, direction)
     geometry = (list(spacing), list(origin), direction.tolist())
-    own_cluster = None
-    if client is None:
-        own_cluster = LocalCluster(n_workers=workers or min(os.cpu_count() or 1, 4), threads_per_worker=1,
-                                   processes=True, dashboard_address=None)
-        client = Client(own_cluster)
-    try:
+    run = _run_name("labels", shape, str(np.dtype(source.dtype)), tuple(block), int(background), adjacency)
+    with _Cluster(client, workers) as client:
         _require_memory(client, block, np.dtype(source.dtype).itemsize)
-        if isinstance(source, np.ndarray):  # sent to the workers once, not with every task
-            source = client.scatter(source, broadcast=False)
-        futures = [client.submit(_mesh_block, source, lo, hi, shape, background, adjacency, work_dir,
-                                 key=f"surftrack-block-{lo[0]}-{lo[1]}-{lo[2]}-{uuid.uuid4().hex[:8]}",
-                                 pure=False) for lo, hi in blocks]
-        done = 0
-        for _ in as_completed(futures):
-            done += 1
-            if progress:
-                progress("blocks", done, len(blocks))
+        futures = _map_blocks(client, _mesh_block, source, blocks, (shape, background, adjacency, work_dir, run),
+                              progress)
         plan = client.submit(_plan, futures, shards or max(1, 2 * len(client.scheduler_info()["workers"])), pure=False)
         shard_list = plan.result()
-        reduced = [client.submit(_reduce_shard, s, geometry, background, adjacency, figures, out_dir, pure=False)
-                   for s in shard_list]
+        reduced = [client.submit(_reduce_shard, s, geometry, background, adjacency, figures, out_dir, naming,
+                                 pure=False) for s in shard_list]
         out, merged, total = {}, 0, sum(len(s) for s in shard_list)
         for future in as_completed(reduced):
             part = future.result()
@@ -168,10 +252,6 @@ def _run(source, *, block, spacing, origin, direction, background, adjacency, fi
             if progress:
                 progress("labels", merged, total)
         return out
-    finally:
-        if own_cluster is not None:
-            client.close()
-            own_cluster.close()
 
 
 def _require_memory(client, block, itemsize):
@@ -231,6 +311,104 @@ def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 
         staging.rmdir()
         raise
     return dict(sorted(figures.items()))
+
+
+def _threshold_block(source, lo, hi, shape, level, adjacency, mapping, epsilon, work_dir, run):
+    """Task: the fragment of one block of a threshold's every boundary (docs/theory.md,
+    "Thresholds by blocks"), written to its file as _mesh_block writes its own."""
+    path = _fragment_path(work_dir, lo, run)
+    if not path.exists():
+        top = [min(h + 1, n) for h, n in zip(hi, shape)]  # the one-voxel apron on the high sides
+        box = np.asarray(source[lo[0]:top[0], lo[1]:top[1], lo[2]:top[2]])
+        box = np.ascontiguousarray(box.view(np.uint8) if box.dtype.kind == "b" else box,
+                                   dtype=None if box.dtype.kind == "b" else box.dtype.newbyteorder("="))
+        voxels, keys, values, triangles = _surftrack.scan_threshold_block(
+            box, list(lo), list(shape), list(lo), list(hi), float(level), adjacency, mapping, float(epsilon))
+        temporary = path.with_name(f".{path.name}.{uuid.uuid4().hex}.npz")
+        np.savez(temporary, voxels=np.uint64(voxels), keys=keys, values=values, triangles=triangles)
+        os.replace(temporary, path)
+    return str(path)
+
+
+def _reduce_threshold(paths, shape, level, geometry, adjacency, mapping, epsilon, figures, out_path, binary):
+    """Task: every block's fragment merged into the one surface of every boundary (all in this
+    worker's memory); written to `out_path` (figures returned) or returned as fields."""
+    from . import Surface
+    fragments = []
+    for path in paths:
+        with np.load(path) as f:
+            fragments.append((int(f["voxels"]), f["keys"], f["values"], f["triangles"]))
+    spacing, origin, direction = geometry
+    fields = _surftrack.merge_threshold_fragments(fragments, list(shape), float(level), spacing, origin, direction,
+                                                  adjacency, mapping, float(epsilon), figures)
+    if out_path is None:  # plain arrays through the scheduler (the C++ result does not pickle)
+        result = fields.pop("result")
+        fields["surfels"], fields["normals"] = result.surfels(), result.normals()
+        return fields
+    surface = Surface(**fields)
+    surface.write(out_path, binary=binary)
+    return {"vertices": len(surface.vertices), "triangles": len(surface.faces), "euler": int(fields["euler"]),
+            "boundaries": len(surface.components)}
+
+
+def _run_threshold(source, level, *, block, mapping, adjacency, spacing, origin, direction, epsilon, figures,
+                   client, workers, work_dir, out_path, binary, progress):
+    from . import _MAPPINGS, _geometry
+
+    shape = _check_volume(source, adjacency, integers=False)
+    level = float(level)
+    if not np.isfinite(level):
+        raise ValueError(f"level must be a finite number, not {level!r}")
+    mapping = {"default": "linear"}.get(mapping, mapping)
+    if mapping not in _MAPPINGS or mapping == "default":
+        raise ValueError(f"unknown mapping '{mapping}': expected linear or midpoint")
+    blocks = block_grid(shape, block)
+    spacing, origin, direction = _geometry(spacing, origin, direction)
+    geometry = (list(spacing), list(origin), direction.tolist())
+    run = _run_name("threshold", shape, str(np.dtype(source.dtype)), tuple(block), level.hex(), adjacency, mapping,
+                    float(epsilon))
+    with _Cluster(client, workers) as client:
+        _require_memory(client, block, np.dtype(source.dtype).itemsize)
+        futures = _map_blocks(client, _threshold_block, source, blocks,
+                              (shape, level, adjacency, mapping, epsilon, work_dir, run), progress)
+        merged = client.submit(_reduce_threshold, futures, shape, level, geometry, adjacency, mapping, epsilon,
+                               figures, out_path, binary, pure=False)
+        out = merged.result()
+        if progress:
+            progress("merge", 1, 1)
+        return out
+
+
+def threshold_surface(volume, level, *, block=(256, 256, 256), mapping="linear", adjacency="26-6",
+                      spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, epsilon=1e-3,
+                      figures=True, client=None, workers=None, work_dir=None, progress=None):
+    """``surftrack.extract(volume, level=level, mode="all", ...)`` computed by blocks on Dask:
+    every boundary of ``volume > level`` as one Surface, array for array. ``volume`` is a 3-D
+    array read by slicing (a zarr array, a numpy array, a memory map). One task per block
+    (fragment files in ``work_dir``, resumable), one merge task, which holds the whole surface:
+    for surfaces larger than one worker's memory, not yet. ``progress(stage, done, total)``
+    with stage "blocks", then "merge". Other arguments as ``label_surfaces``."""
+    from . import Surface
+    with _work_dir(work_dir) as work:
+        fields = _run_threshold(volume, level, block=block, mapping=mapping, adjacency=adjacency, spacing=spacing,
+                                origin=origin, direction=direction, epsilon=epsilon, figures=figures,
+                                client=client, workers=workers, work_dir=work, out_path=None, binary=True,
+                                progress=progress)
+    return Surface(**fields)
+
+
+def write_threshold_mesh(volume, path, level, *, block=(256, 256, 256), mapping="linear", adjacency="26-6",
+                         spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, epsilon=1e-3,
+                         binary=True, client=None, workers=None, work_dir=None, progress=None) -> dict:
+    """Every boundary of ``volume > level`` written to ``path`` (.ply, .obj, .off, .stl) by the
+    merge task, byte-identical to ``surftrack.extract(volume, level=level, mode="all",
+    ...).write(path)`` (atomic, as Surface.write). ``path`` must be on storage the workers see.
+    Returns figures (vertices, triangles, euler, boundaries)."""
+    with _work_dir(work_dir) as work:
+        return _run_threshold(volume, level, block=block, mapping=mapping, adjacency=adjacency, spacing=spacing,
+                              origin=origin, direction=direction, epsilon=epsilon, figures=True, client=client,
+                              workers=workers, work_dir=work, out_path=os.path.abspath(os.fspath(path)),
+                              binary=binary, progress=progress)
 
 
 class _work_dir:

@@ -5,6 +5,7 @@ blocks and a single block included), byte-identical PLY files from a zarr store,
 around 2^53 and 2^64 - 1 exact, a resumed run that recomputes no finished block, a worker killed
 mid-run that changes nothing, and bad input refused before the run."""
 import os
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -145,3 +146,174 @@ def test_bad_input_is_refused_before_the_run(client, tmp_path):
     with pytest.raises(ValueError, match="not an empty directory"):
         blocks.write_label_meshes(labels, full, client=client)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["full"]
+
+
+def test_a_work_dir_reused_with_other_arguments_recomputes(client, tmp_path):
+    # The fragments depend on the background (and the pair, the block, the array): a second run
+    # in the same work_dir with another background must not merge the first run's fragments.
+    labels = random_labels(np.random.default_rng(23), (10, 9, 11))
+    work = tmp_path / "fragments"
+    blocks.label_surfaces(labels, block=(5, 5, 5), client=client, work_dir=work)
+    other = blocks.label_surfaces(labels, block=(5, 5, 5), client=client, work_dir=work, background=int(IDS[1]))
+    expect_same(other, surftrack.label_surfaces(labels, background=int(IDS[1])))
+    assert len(list(work.iterdir())) == 2 * len(blocks.block_grid(labels.shape, (5, 5, 5)))
+
+
+THRESHOLD_CASES = [(np.float32, "linear"), (np.uint8, "midpoint"), (">f8", "linear"), (np.int16, "linear"),
+                   (bool, "midpoint")]
+
+
+@pytest.mark.parametrize("dtype,mapping", THRESHOLD_CASES)
+def test_threshold_blocks_merge_to_the_single_pass(client, dtype, mapping):
+    rng = np.random.default_rng(zlib.crc32(repr((dtype, mapping)).encode()))
+    for trial, block in enumerate([(4, 3, 5), (1, 6, 2), (30, 30, 30), (5, 1, 7)]):
+        shape = tuple(int(n) for n in rng.integers(6, 12, size=3))
+        volume = (rng.random(shape) * 200).astype(dtype) if dtype is not bool else rng.random(shape) > 0.6
+        level = 0.5 if dtype is bool else 120.5
+        adjacency = ["26-6", "18-6", "6-18", "6-26"][trial]
+        spacing = tuple(float(s) for s in rng.uniform(0.5, 2.0, size=3))
+        want = surftrack.extract(volume, level=level, mode="all", mapping=mapping, adjacency=adjacency,
+                                 spacing=spacing, origin=(1, -2, 3), threads=1)
+        got = blocks.threshold_surface(volume, level, block=block, mapping=mapping, adjacency=adjacency,
+                                       spacing=spacing, origin=(1, -2, 3), client=client)
+        assert got.vertices.tobytes() == want.vertices.tobytes()
+        assert np.array_equal(got.faces, want.faces) and np.array_equal(got.surfels, want.surfels)
+        assert got.euler == want.euler and got.components == want.components
+
+
+def test_threshold_mesh_from_a_zarr_store_is_byte_identical_and_resumes(client, tmp_path):
+    rng = np.random.default_rng(29)
+    shape = (41, 37, 33)
+    z, y, x = np.indices(shape)
+    volume = (np.sin(x / 4.0) + np.cos(y / 5.0) * np.sin(z / 3.0) + rng.normal(0, 0.05, shape)).astype(np.float32)
+    zarr.open(str(tmp_path / "v.zarr"), mode="w", shape=shape, chunks=(9, 10, 11), dtype="<f4")[:] = volume
+    source = zarr.open(str(tmp_path / "v.zarr"), mode="r")
+    seen = []
+    work = tmp_path / "fragments"
+    figures = blocks.write_threshold_mesh(source, tmp_path / "a.ply", 0.25, block=(16, 20, 12), spacing=(3, 2, 1),
+                                          client=client, work_dir=work,
+                                          progress=lambda stage, done, total: seen.append((stage, done, total)))
+    want = surftrack.extract(volume, level=0.25, mode="all", spacing=(3, 2, 1), threads=1)
+    want.write(str(tmp_path / "b.ply"))
+    assert (tmp_path / "a.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
+    assert figures["vertices"] == len(want.vertices) and figures["euler"] == want.euler
+    assert figures["boundaries"] == len(want.components) == 3  # (two of genus 4 and a speck)
+    assert ("blocks", 18, 18) in seen and seen[-1] == ("merge", 1, 1)
+    stamps = {p.name: p.stat().st_mtime_ns for p in work.iterdir()}
+    blocks.write_threshold_mesh(source, tmp_path / "c.ply", 0.25, block=(16, 20, 12), spacing=(3, 2, 1),
+                                client=client, work_dir=work)
+    assert {p.name: p.stat().st_mtime_ns for p in work.iterdir()} == stamps
+    assert (tmp_path / "c.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
+    # Another level in the same work_dir: recomputed, not the first level's fragments.
+    blocks.write_threshold_mesh(source, tmp_path / "d.ply", 0.5, block=(16, 20, 12), spacing=(3, 2, 1),
+                                client=client, work_dir=work)
+    surftrack.extract(volume, level=0.5, mode="all", spacing=(3, 2, 1), threads=1).write(str(tmp_path / "e.ply"))
+    assert (tmp_path / "d.ply").read_bytes() == (tmp_path / "e.ply").read_bytes()
+
+
+def test_threshold_bad_input(client):
+    volume = np.zeros((6, 6, 6), np.float32)
+    with pytest.raises(ValueError, match="mapping"):
+        blocks.threshold_surface(volume, 0.5, mapping="cubic", client=client)
+    with pytest.raises(ValueError, match="finite"):
+        blocks.threshold_surface(volume, float("nan"), client=client)
+    with pytest.raises(ValueError, match="3-D"):
+        blocks.threshold_surface(volume[0], 0.5, client=client)
+    with pytest.raises(ValueError, match="adjacency"):
+        blocks.threshold_surface(volume, 0.5, adjacency="8-4", client=client)
+
+
+def cli():
+    path = os.environ.get("SURFTRACK_CLI") or str(Path(__file__).resolve().parents[2] / "build" / "cli" / "surftrack")
+    if not os.access(path, os.X_OK):
+        pytest.skip(f"the surftrack CLI is not built at {path}")
+    return path
+
+
+def run_cli(*args):
+    import subprocess
+    return subprocess.run([cli(), *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+def test_cli_labels_on_dask_writes_the_single_pass_files_and_table(tmp_path):
+    """`surftrack labels STORE -o DIR/ --dask local:2` against the CLI's own single pass on the
+    same store: every mesh file byte for byte, labels.csv and --table equal (but for the
+    directory in the file column), with label names ('/' made '_'), a geometry override,
+    an OME-Zarr level and --ascii."""
+    rng = np.random.default_rng(31)
+    shape = (37, 29, 41)
+    seeds = rng.integers(0, shape, size=(15, 3))
+    grid = np.stack(np.indices(shape), axis=-1).reshape(-1, 1, 3)
+    cells = np.argmin(((grid - seeds[None]) ** 2).sum(-1), axis=1).reshape(shape).astype(np.uint16)
+    cells[cells == 4] = 0  # one cell is background
+    store = tmp_path / "seg.ome.zarr"
+    root = zarr.open_group(str(store), mode="w")
+    for level, data in enumerate([cells, cells[::2, ::2, ::2]]):
+        root.create_dataset(f"s{level}", data=data, chunks=(8, 9, 7))
+    root.attrs["multiscales"] = [{"version": "0.4", "axes": [{"name": a, "type": "space", "unit": "micrometer"}
+                                                              for a in "zyx"],
+                                  "datasets": [{"path": f"s{k}", "coordinateTransformations": [
+                                      {"type": "scale", "scale": [2.0 * 2**k, 1.5 * 2**k, 1.0 * 2**k]}]}
+                                      for k in range(2)]}]
+    names = tmp_path / "names.txt"
+    names.write_text("".join(f"{L} region/{L}\n" for L in range(1, 15, 2)))  # ('/' made '_' in file names)
+    for extra in [[], ["--level", 1, "--ascii", "--spacing", "1,2,3", "--adjacency", "6-26"]]:
+        single, dask = tmp_path / f"single{len(extra)}", tmp_path / f"dask{len(extra)}"
+        common = ["--label-names", names, *extra]
+        a = run_cli("labels", store, "-o", f"{single}/", *common, "--table", tmp_path / "a.json")
+        assert a.returncode == 0, a.stderr
+        b = run_cli("labels", store, "-o", f"{dask}/", *common, "--table", tmp_path / "b.json", "--dask", "local:2",
+                    "--block", "16,10,12", "--work-dir", tmp_path / f"work{len(extra)}")
+        assert b.returncode == 0, b.stderr
+        assert "blocks meshed" in b.stderr and "labels merged" in b.stderr
+        files = sorted(p.name for p in single.iterdir())
+        assert files == sorted(p.name for p in dask.iterdir()) and len(files) == 14  # 13 labels + labels.csv
+        assert "1_region_1.ply" in files and "2_label2.ply" in files
+        for f in files:
+            left, right = (single / f).read_bytes(), (dask / f).read_bytes()
+            if f == "labels.csv":
+                left, right = left.replace(str(single).encode(), b"D"), right.replace(str(dask).encode(), b"D")
+            assert left == right, f
+        assert (tmp_path / "a.json").read_text().replace(str(single), "D") == \
+            (tmp_path / "b.json").read_text().replace(str(dask), "D")
+
+
+def test_cli_labels_on_dask_bad_input(tmp_path):
+    zarr.open(str(tmp_path / "s.zarr"), mode="w", shape=(6, 6, 6), chunks=(3, 3, 3), dtype="<u2")[:] = 1
+    (tmp_path / "v.raw").write_bytes(bytes(216))
+    cases = [(["labels", tmp_path / "v.raw", "--raw-dims", "6,6,6", "--raw-type", "uint8", "-o", f"{tmp_path}/a/",
+               "--dask", "local:2"], "chunked store"),
+             (["labels", tmp_path / "s.zarr", "-o", tmp_path / "all.ply", "--dask", "local:2"], "-o DIR/"),
+             (["labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/b/", "--dask", "local:2", "--labels", "1"], "not with"),
+             (["labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/c/", "--block", "4,4,4"], "for --dask"),
+             (["labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/d/", "--dask", "local:0"], "local:N")]
+    for args, says in cases:
+        r = run_cli(*args)
+        assert r.returncode != 0 and says in r.stderr and r.stderr.count("\n") == 1, (args, r.stderr)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr", "v.raw"]  # nothing written, no temporary left
+
+
+def test_cli_mesh_all_on_dask_writes_the_single_pass_file(tmp_path):
+    """`surftrack mesh STORE --all --iso S -o FILE --dask local:2` against the CLI's single pass
+    on the same store: the same bytes, in PLY and OBJ, both mappings, a geometry override; the
+    figures it prints are the single pass's."""
+    rng = np.random.default_rng(37)
+    shape = (27, 22, 31)
+    volume = (rng.random(shape) * 200).astype(">f4")
+    zarr.open(str(tmp_path / "v.zarr"), mode="w", shape=shape, chunks=(7, 9, 5), dtype=">f4")[:] = volume
+    for out, extra in [("a.ply", ["--spacing", "1,2,3"]), ("b.obj", ["--mapping", "midpoint", "--adjacency", "6-18"])]:
+        single, dask = tmp_path / f"single-{out}", tmp_path / f"dask-{out}"
+        a = run_cli("mesh", tmp_path / "v.zarr", "--all", "--iso", 120, "-o", single, *extra, "--json")
+        assert a.returncode == 0, a.stderr
+        b = run_cli("mesh", tmp_path / "v.zarr", "--all", "--iso", 120, "-o", dask, *extra, "--json",
+                    "--dask", "local:2", "--block", "8,12,10")
+        assert b.returncode == 0, b.stderr
+        assert single.read_bytes() == dask.read_bytes()
+        import json
+        want, got = json.loads(a.stdout), json.loads(b.stdout)
+        assert (got["vertices"], got["triangles"], got["boundaries"], got["euler_characteristic"]) == \
+            (want["vertices"], want["triangles"], want["components"], want["euler_characteristic"])
+    for args, says in [(["--seed", "3,3,3"], "--all"), (["--all"], "--iso"), (["--all", "--iso", 1, "--smooth"], "--smooth")]:
+        r = run_cli("mesh", tmp_path / "v.zarr", *args, "-o", tmp_path / "c.ply", "--dask", "local:2")
+        assert r.returncode != 0 and says in r.stderr and r.stderr.count("\n") == 1, r.stderr
+    assert not (tmp_path / "c.ply").exists()

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "Geometry.h"
 #include "ScalarType.h"
@@ -87,9 +88,17 @@ class ChunkCache {
   std::unique_ptr<State> state_;
 };
 
+/// Copies the voxels of the box [lo, lo + extent) — inside layout().dims — out of the chunks
+/// that hold it into `out` (extent voxels of the layout's type, x fastest): how a block of a
+/// store is read whole (the block meshing, docs/python.md "Every label by blocks, on Dask").
+/// Throws InvalidInput for a box outside the array; rethrows the provider's errors.
+void copyBox(const ChunkCache& cache, Voxel lo, Dims extent, void* out);
+
 /// A source reading through `cache` (shared: its counters stay readable after extraction).
 /// Voxels outside layout().dims are 0-voxels, as for every source; a chunk's edge is never the
-/// domain's edge.
-std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache);
+/// domain's edge. `geometry`, when given, is the one the source reports instead of the
+/// layout's: the caller's spacing, origin or frame over a store's voxels.
+std::unique_ptr<VoxelSource> makeChunkedSource(std::shared_ptr<const ChunkCache> cache,
+                                               std::optional<ImageGeometry> geometry = std::nullopt);
 
 }  // namespace surftrack

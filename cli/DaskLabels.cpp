@@ -1,0 +1,58 @@
+// `surftrack labels STORE -o DIR/ --dask ADDRESS` (DaskLabels.h).
+#include "DaskLabels.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include "DaskJob.h"
+
+namespace surftrack::cli {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+std::vector<LabelRow> labelRowsOnDask(const LabelsOptions& o, const LabelNames& names, StagedOutputs& staged) {
+  ImageGeometry g;
+  json job = storeJob(o.input, o.dask, o.block, o.workDir, g);
+  const std::string staging = staged.stagingDirectory();
+  job["kind"] = "labels";
+  job["background"] = o.background.text();
+  job["adjacency"] = toString(o.pair);
+  job["staging"] = staging;
+  json named = json::object();
+  for (const auto& [label, name] : names) named[label.text()] = name;
+  job["names"] = named;
+  job["binary"] = !o.ascii;
+  job["quiet"] = o.out.quiet;
+  const json result = runDaskJob(job, staging, staging);
+  if (!result.is_array()) throw std::runtime_error("the Dask driver gave no table");
+
+  const double voxelVolume = std::abs(g.handedness());
+  std::vector<LabelRow> rows;
+  std::set<std::string> files;
+  for (const json& f : result) {
+    LabelRow r;
+    r.label = *LabelValue::parse(f["label"].get<std::string>());
+    r.name = labelName(names, r.label);
+    r.voxels = f["voxels"].get<std::uint64_t>();
+    r.voxelVolume = double(r.voxels) * voxelVolume;
+    r.surfels = f["vertices"].get<std::size_t>();
+    r.triangles = f["triangles"].get<std::size_t>();
+    r.boundaries = f["boundaries"].get<std::size_t>();
+    r.euler = f["euler"].get<long long>();
+    r.genus = (2.0 * double(r.boundaries) - double(r.euler)) / 2.0;
+    r.area = f["area"].get<double>();
+    r.volume = f["volume"].get<double>();
+    r.file = (fs::path(o.output) / f["file"].get<std::string>()).string();  // as the single pass names it
+    if (!files.insert(r.file).second)
+      throw UsageError("two labels give the file name '" + r.file + "': their names are the same");
+    staged.temporaryFor(r.file);  // (written there by a reducer)
+    rows.push_back(std::move(r));
+  }
+  std::sort(rows.begin(), rows.end(), [](const LabelRow& a, const LabelRow& b) { return a.label < b.label; });
+  return rows;
+}
+
+}  // namespace surftrack::cli
