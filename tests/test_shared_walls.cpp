@@ -634,6 +634,34 @@ TEST(SharedWalls, TheSmallestPinch) {
             << " pinched edges, " << topology.components << " components, euler " << topology.euler << "\n";
 }
 
+/// Under a mirrored geometry the normals still point out of each label (placeSurface's rule):
+/// every label's signed volume is positive, and the same as without the mirror.
+TEST(SharedWalls, MirroredGeometryKeepsNormalsOutwards) {
+  std::mt19937_64 rng(25);
+  for (int image = 0; image < 50; ++image) {
+    const Dims dims{4, 3, 5};
+    const std::vector<std::uint16_t> data = randomLabels(rng, dims, 6, true);
+    LabelOptions options;
+    options.walls = LabelWalls::Shared;
+    options.threads = 1;
+    ImageGeometry mirror;
+    mirror.spacing = {0.5, 2.0, 1.5};
+    mirror.direction = {{{1, 0, 0}, {0, 1, 0}, {0, 0, -1}}};
+    const auto plain = extractLabels(VolumeView::of(data.data(), dims), options);
+    const auto mirrored = extractLabels(VolumeView::of(data.data(), dims, mirror), options);
+    ASSERT_EQ(plain.size(), mirrored.size());
+    for (std::size_t l = 0; l < plain.size(); ++l) {
+      TriangleMesh a, b;
+      a.triangles = plain[l].surface.triangles;
+      b.triangles = mirrored[l].surface.triangles;
+      const double va = testing::signedVolume(a, plain[l].surface.vertices);
+      const double vb = testing::signedVolume(b, mirrored[l].surface.vertices);
+      EXPECT_GT(va, 0);
+      EXPECT_NEAR(vb, va * 0.5 * 2.0 * 1.5, 1e-9 * (1 + va)) << "image " << image;
+    }
+  }
+}
+
 TEST(SharedWalls, Refusals) {
   std::vector<std::uint8_t> data(8, 1);
   LabelOptions options;
