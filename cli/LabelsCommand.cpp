@@ -144,6 +144,7 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
     // By blocks on Dask: the same files and table, no volume in this process (DaskLabels.h).
     if (kind != OutputKind::Directory)
       throw UsageError("--dask writes -o DIR/ (one file per label), not '" + o.output + "'");
+    if (o.walls != "independent") throw UsageError("--walls shared is not made by blocks yet: no --dask");
     run.rows = labelRowsOnDask(o, names, staged);
     clock.lap(timings, "dask");
     writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(run.rows));
@@ -165,8 +166,12 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   options.boundaries = o.largest ? LabelBoundaries::Largest : LabelBoundaries::All;
   options.seeds = o.seeds;
   options.pair = o.pair;
+  options.walls = o.walls == "shared" ? LabelWalls::Shared : LabelWalls::Independent;
   options.threads = o.threads;
   const std::vector<LabelSurface> surfaces = extractLabels(view, options);
+  if (!o.out.quiet)
+    for (const LabelSurface& l : surfaces)
+      for (const std::string& w : l.surface.warnings) std::cerr << "surftrack: warning: " << w << "\n";
   clock.lap(timings, "extract");
 
   // The rows, and the file of each label.
@@ -217,6 +222,13 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   } else if (kind == OutputKind::OnePly) {
     writeLabelSurfaces(surfaces, o.output, binary);
   } else {
+    // A mesh file holds a 2-manifold; shared walls may leave a label edges of four triangles
+    // (docs/theory.md §12), which only the one PLY of every label carries.
+    for (const LabelSurface& ls : surfaces)
+      if (ls.unsplitEdges)
+        throw InvalidInput("label " + ls.label.text() + " has " + std::to_string(ls.unsplitEdges) +
+                           " edges of four triangles with --walls shared (it touches itself along them): write every "
+                           "label to one .ply (-o FILE.ply) instead");
     for (std::size_t i = 0; i < surfaces.size(); ++i) writeSurface(surfaces[i].surface, staged.temporaryFor(rows[i].file), binary);
     if (kind == OutputKind::Directory) writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(rows));
     staged.commit();
@@ -237,6 +249,7 @@ int runLabels(const std::vector<std::string>& args) {
     j["output"] = o.output;
     j["names"] = namesFile;
     j["adjacency"] = toString(o.pair);
+    j["walls"] = o.walls;
     j["labels"] = labelTableJson(rows);
     nlohmann::ordered_json t = nlohmann::ordered_json::object();
     for (const StageTiming& s : run.timings) t[s.name] = number(s.seconds);

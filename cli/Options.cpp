@@ -718,6 +718,11 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
       ->option_text("FILE")
       ->group(which);
   app.add_flag("--no-label-names", o.noNames, "ignore the sidecar names")->group(which);
+  app.add_option("--walls", o.walls, "independent (default): each label against the rest; shared: one\n"
+                 "conforming complex, walls shared triangle for triangle (docs/theory.md)")
+      ->option_text("W")
+      ->check(CLI::IsMember({"independent", "shared"}))
+      ->group(which);
   addDaskOptions(app, o.dask, args.block, o.workDir, "by blocks on Dask (a chunked store, -o DIR/)",
                  "the same files and table as the single pass");
   addSurfaceOptions(app, o.pair, o.ascii, o.threads,

@@ -111,6 +111,7 @@ struct LabelsOptions {
   bool largest = false;                            ///< --largest
   std::vector<Voxel> seeds;                        ///< --seed x,y,z (repeatable)
   AdjacencyPair pair = AdjacencyPair::k26_6;
+  std::string walls = "independent";               ///< --walls independent|shared
   int threads = 0;
   bool ascii = false;
   std::string table;  ///< --table FILE.csv | FILE.json

@@ -85,6 +85,8 @@ std::vector<LabelFragment> scanLabelBlock(const VolumeView& view, Voxel origin, 
     throw InvalidInput("threads " + std::to_string(options.threads) + " is negative (0: all cores)");
   if (!options.seeds.empty())
     throw InvalidInput("a block scan meshes every boundary: seeds select boundaries of the whole volume");
+  if (options.walls != LabelWalls::Independent)
+    throw InvalidInput("a block scan gives independent walls only: shared walls are not split into blocks yet");
   if (options.boundaries != LabelBoundaries::All)
     throw InvalidInput("a block scan meshes every boundary: the largest is a property of the whole volume");
   makeViewSource(view);  // checks the view

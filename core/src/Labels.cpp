@@ -30,6 +30,7 @@
 #include "ScanLabels.h"
 #include "ScannedLabel.h"
 #include "SelectionValue.h"
+#include "SharedWallLabels.h"
 #include "SourceImage.h"
 #include "TrackBoundaries.h"
 
@@ -213,6 +214,15 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
   const bool fromSeeds = !o.seeds.empty();
   if (fromSeeds && o.boundaries == LabelBoundaries::Largest)
     throw InvalidInput("seeds select their own boundaries: give seeds or the largest boundary, not both");
+  if (o.walls == LabelWalls::Shared) {
+    if (fromSeeds || o.boundaries != LabelBoundaries::All)
+      throw InvalidInput("shared walls partition the whole image: every boundary of every label, no seeds or largest");
+    if (o.pair != AdjacencyPair::k26_6 && o.pair != AdjacencyPair::k6_26)
+      throw InvalidInput("shared walls take the adjacency pair 26-6 or 6-26, not " + toString(o.pair));
+    return sharedWallSurfaces(image, source, o, [&](const std::vector<T>& labels) {
+      return selectLabels(labels, o.labels, o.background);
+    });
+  }
   if (!fromSeeds && o.boundaries == LabelBoundaries::All) return scanAll(image, source, o, arena, parts);
 
   // Some boundaries of each label: one scan of the rows for seeds, slabs of planes in

@@ -552,9 +552,12 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
                             const std::string& boundaries, std::vector<std::array<int, 3>> seeds,
                             const std::string& adjacency, std::array<double, 3> spacing,
                             std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
-                            int threads, bool figures) {
+                            int threads, bool figures, const std::string& walls) {
   const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
   LabelOptions o;
+  if (walls != "independent" && walls != "shared")
+    throw InvalidInput("unknown walls '" + walls + "': expected 'independent' or 'shared'");
+  o.walls = walls == "shared" ? LabelWalls::Shared : LabelWalls::Independent;
   if (selectionKind == "list") {
     std::vector<LabelValue> list;
     for (py::handle L : labels) list.push_back(labelOf(L, "label"));

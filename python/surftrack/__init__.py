@@ -406,7 +406,8 @@ def extract(volume, *, level: Optional[float] = None, label: Optional[int] = Non
 def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=None,
                    background: int = 0, boundaries: str = "all", seeds: Optional[Sequence] = None,
                    adjacency: str = "26-6", spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
-                   direction=None, affine=None, threads: int = 0, figures: bool = True) -> dict:
+                   direction=None, affine=None, threads: int = 0, figures: bool = True,
+                   walls: str = "independent") -> dict:
     """Every label of an integer label image as a closed surface: a dict label -> Surface.
 
     One scan of the cubes triangulates every boundary of every label at once ("largest" and
@@ -417,7 +418,10 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     ``background`` label gets no surface. ``boundaries`` is "all" (default) or "largest" per
     label; ``seeds`` (voxel indices) keeps only the boundaries reached walking along +k (the last
     axis) from each seed to its label's boundary, and only their labels. Geometry as in
-    ``extract``.
+    ``extract``. ``walls="shared"`` makes all the labels one conforming complex (every wall one
+    set of triangles used by both its labels, space partitioned exactly; docs/theory.md, "Shared
+    walls"; every boundary only: no seeds, not "largest"); "independent" (default) meshes each
+    label against the rest.
     Raises ValueError (surftrack.InvalidInput) / TypeError on bad input.
     """
     array = _as_volume(labels)
@@ -434,6 +438,8 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     if adjacency not in _ADJACENCIES:
         raise ValueError(f"unsupported adjacency pair '{adjacency}': expected one of "
                          + ", ".join(_ADJACENCIES))
+    if walls not in ("independent", "shared"):
+        raise ValueError(f"unknown walls '{walls}': expected 'independent' or 'shared'")
     # Labels reach the engine as Python ints (tolist() turns numpy integers into ints), never
     # through float: uint64 segment ids above 2^53 stay exact.
     kind, values, bounds = "all", [], []
@@ -459,7 +465,7 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
         array = np.ascontiguousarray(array)
     out = _surftrack.label_surfaces_array(array, [2, 1, 0], kind, values, bounds, background,
                                           boundaries, seed_list, adjacency, spacing, origin,
-                                          direction.tolist(), int(threads), bool(figures))
+                                          direction.tolist(), int(threads), bool(figures), walls)
     return {label: Surface(**fields) for label, fields in out.items()}
 
 

@@ -49,6 +49,22 @@ enum class LabelBoundaries {
   Largest  ///< the boundary with the most surfels (ties: the first met by the scan)
 };
 
+/// How touching labels' surfaces relate (docs/theory.md, "Shared walls").
+enum class LabelWalls {
+  /// Each label against everything else with the pair's rule: touching labels share their wall
+  /// vertices but not their triangles, and may overlap or leave gaps where three labels meet or
+  /// two touch diagonally.
+  Independent,
+  /// One conforming complex: the labels in priority order (the background lowest, then by
+  /// increasing label), each wall one set of triangles used by the two labels it separates with
+  /// opposite orientations, the regions a partition of space, vertices the surfels between
+  /// differing labels. Where a label touches itself at a vertex or along an edge (a pinch) its
+  /// surface gets a copy of the vertex per sheet (LabelSurface::pinchCopies), where a copy can
+  /// separate them. Every boundary of
+  /// every label: no seeds, not LabelBoundaries::Largest; pairs 26-6 and 6-26 only.
+  Shared
+};
+
 struct LabelOptions {
   LabelSelection labels;
   /// The label of no surface: its voxels are 0-voxels of every label.
@@ -60,6 +76,9 @@ struct LabelOptions {
   /// must be selected and not the background; `boundaries` must be All.
   std::vector<Voxel> seeds;
   AdjacencyPair pair = AdjacencyPair::k26_6;
+  /// Independent: each label's own (kappa, lambda) surfaces. Shared: the conforming complex,
+  /// each level of the priority order's analog with this pair.
+  LabelWalls walls = LabelWalls::Independent;
   /// Threads for the scan and for the labels: 0 for all cores. The surfaces are the same for any
   /// number.
   int threads = 0;
@@ -77,6 +96,11 @@ struct LabelSurface {
   /// selection = Selection::label(label), mapping Midpoint; boundariesInImage: every boundary
   /// of the label for LabelBoundaries::All and Largest, 0 (not counted) with seeds.
   Surface surface;
+  /// LabelWalls::Shared: vertex copies made where the label touches itself (pinches), each at the
+  /// same point and surfel as its original; the edges of more than two of its triangles; and
+  /// those of them no copy separates (still of four or more triangles: the surface is a closed
+  /// oriented 2-cycle but not a 2-manifold there).
+  std::size_t pinchCopies = 0, pinchedEdges = 0, unsplitEdges = 0;
 };
 
 /// The surfaces of the selected labels of `view`, by increasing label. Labels are exact over

@@ -1,0 +1,133 @@
+// Pinches of a region's boundary split into sheets (PinchSplit.h).
+#include "PinchSplit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+namespace surftrack {
+namespace {
+
+using P = std::array<double, 3>;
+P sub(const P& a, const P& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+P cross(const P& a, const P& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double dot(const P& a, const P& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+struct UnionFind {
+  std::vector<std::uint32_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  std::uint32_t find(std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void join(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
+};
+
+}  // namespace
+
+PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
+                        const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  // Every triangle side as (low vertex, high vertex, triangle, corner of its first vertex),
+  // sorted so that the sides of one edge are together.
+  struct Side {
+    std::uint32_t lo, hi, triangle;
+    std::uint8_t corner;  // the side runs from corner to corner + 1 of its triangle
+  };
+  std::vector<Side> sides;
+  sides.reserve(3 * triangles.size());
+  for (std::uint32_t t = 0; t < triangles.size(); ++t)
+    for (std::uint8_t j = 0; j < 3; ++j) {
+      const std::uint32_t a = triangles[t][j], b = triangles[t][(j + 1) % 3];
+      sides.push_back({std::min(a, b), std::max(a, b), t, j});
+    }
+  std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
+    return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.triangle < y.triangle;
+  });
+  // Corners 3t + j; two corners joined are one sheet at their vertex.
+  UnionFind sheets(3 * triangles.size());
+  PinchSplit out;
+  auto runsLowToHigh = [&](const Side& s) { return triangles[s.triangle][s.corner] == s.lo; };
+  auto pair = [&](const Side& x, const Side& y) {  // the two triangles bound one sector
+    const std::uint32_t tx = x.triangle, ty = y.triangle;
+    for (std::uint32_t v : {x.lo, x.hi}) {
+      const auto cx = std::uint32_t(std::find(triangles[tx].begin(), triangles[tx].end(), v) - triangles[tx].begin());
+      const auto cy = std::uint32_t(std::find(triangles[ty].begin(), triangles[ty].end(), v) - triangles[ty].begin());
+      sheets.join(3 * tx + cx, 3 * ty + cy);
+    }
+  };
+  std::vector<std::pair<double, std::size_t>> around;
+  for (std::size_t b = 0; b < sides.size();) {
+    std::size_t e = b;
+    while (e < sides.size() && sides[e].lo == sides[b].lo && sides[e].hi == sides[b].hi) ++e;
+    const std::size_t n = e - b;
+    if (n == 2 && runsLowToHigh(sides[b]) != runsLowToHigh(sides[b + 1])) {
+      pair(sides[b], sides[b + 1]);
+    } else {
+      std::size_t forward = 0;
+      for (std::size_t i = b; i < e; ++i) forward += runsLowToHigh(sides[i]);
+      if (2 * forward != n) throw std::logic_error("splitPinches: an edge's triangles are not matched in orientation");
+      ++out.pinchedEdges;
+      // Angles around d = hi - lo, counter-clockwise (right-hand rule about d).
+      const P& a = points[sides[b].lo];
+      const P d = sub(points[sides[b].hi], a);
+      P e1 = std::abs(d[0]) < std::abs(d[1]) ? (std::abs(d[0]) < std::abs(d[2]) ? P{1, 0, 0} : P{0, 0, 1})
+                                             : (std::abs(d[1]) < std::abs(d[2]) ? P{0, 1, 0} : P{0, 0, 1});
+      e1 = cross(cross(d, e1), d);  // orthogonal to d
+      const P e2 = cross(d, e1);
+      around.clear();
+      for (std::size_t i = b; i < e; ++i) {
+        const auto& t = triangles[sides[i].triangle];
+        const P u = sub(points[t[(sides[i].corner + 2) % 3]], a);
+        around.push_back({std::atan2(dot(u, e2), dot(u, e1)), i});
+      }
+      std::sort(around.begin(), around.end());
+      // A triangle whose side runs hi -> lo has its outward normal turned clockwise: the region
+      // lies counter-clockwise of it, up to the next triangle, which must run lo -> hi.
+      for (std::size_t k = 0; k < n; ++k) {
+        const Side& x = sides[around[k].second];
+        if (runsLowToHigh(x)) continue;
+        const Side& y = sides[around[(k + 1) % n].second];
+        if (!runsLowToHigh(y)) throw std::logic_error("splitPinches: the triangles around an edge do not alternate");
+        pair(x, y);
+      }
+    }
+    b = e;
+  }
+  // Each vertex's sheets: the first keeps the vertex, the others get copies.
+  out.triangles = triangles;
+  std::vector<std::uint32_t> copy(3 * triangles.size(), ~0u);  // root corner -> vertex
+  std::vector<char> taken(points.size(), 0);
+  for (std::uint32_t t = 0; t < triangles.size(); ++t)
+    for (std::uint32_t j = 0; j < 3; ++j) {
+      const std::uint32_t root = sheets.find(3 * t + j), v = triangles[t][j];
+      if (copy[root] == ~0u) {
+        if (!taken[v]) {
+          taken[v] = 1;
+          copy[root] = v;
+        } else {
+          copy[root] = std::uint32_t(points.size() + out.copyOf.size());
+          out.copyOf.push_back(v);
+        }
+      }
+      out.triangles[t][j] = copy[root];
+    }
+  std::vector<std::uint64_t> edges;
+  for (const auto& t : out.triangles)
+    for (int j = 0; j < 3; ++j) {
+      const std::uint64_t a = t[std::size_t(j)], b = t[std::size_t((j + 1) % 3)];
+      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t e = i;
+    while (e < edges.size() && edges[e] == edges[i]) ++e;
+    out.unsplitEdges += e - i > 2;
+    i = e;
+  }
+  return out;
+}
+
+}  // namespace surftrack

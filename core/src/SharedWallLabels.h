@@ -1,0 +1,163 @@
+// extractLabels with LabelWalls::Shared (docs/theory.md, "Shared walls"): every label's surface
+// as a part of one conforming complex. One scan of the digital 3-cubes gives each cube's walls
+// (converter/NestedWalls.h: the nested analogs of the labels in priority order, the background
+// lowest, then by increasing label); each wall triangle goes to the two labels it separates,
+// as it is to the one inside and reversed to the one outside. A vertex is a grid edge between
+// two voxels of different labels (a surfel), numbered per label at its first use; where a label
+// touches itself at a vertex or an edge the pinch is split (converter/PinchSplit.h) and counted.
+// One thread; the labels' meshes are the same for any `threads`.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "BoundaryMapping.h"
+#include "DigitalCube.h"
+#include "Image.h"
+#include "Labels.h"
+#include "NestedWalls.h"
+#include "PhysicalRange.h"
+#include "PinchSplit.h"
+#include "ScannedLabel.h"
+#include "SourceImage.h"
+
+namespace surftrack {
+
+/// The surfaces of the labels select(labels) picks (indices into the increasing non-background
+/// labels of the image), with shared walls.
+template <class T, class Select>
+std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const VoxelSource& source,
+                                             const LabelOptions& o, Select&& select) {
+  const Dims dims = image.dims;
+  const T background = o.background.as<T>();
+  // 1. Priorities: the background (and every voxel outside the domain) 0, the labels 1, 2, ...
+  //    by increasing value.
+  std::vector<T> labels;
+  labels.reserve(std::size_t(dims.nx) * std::size_t(dims.ny) * std::size_t(dims.nz));
+  for (int z = 0; z < dims.nz; ++z)
+    for (int y = 0; y < dims.ny; ++y)
+      for (int x = 0; x < dims.nx; ++x)
+        if (image.at(x, y, z) != background) labels.push_back(image.at(x, y, z));
+  std::sort(labels.begin(), labels.end());
+  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  const std::vector<std::size_t> selected = select(labels);
+  std::vector<std::uint32_t> priority(std::size_t(dims.nx) * std::size_t(dims.ny) * std::size_t(dims.nz));
+  std::vector<std::uint64_t> voxels(labels.size() + 1, 0);
+  for (int z = 0, i = 0; z < dims.nz; ++z)
+    for (int y = 0; y < dims.ny; ++y)
+      for (int x = 0; x < dims.nx; ++x, ++i) {
+        const T v = image.at(x, y, z);
+        const auto p = v == background
+                           ? 0u
+                           : std::uint32_t(std::lower_bound(labels.begin(), labels.end(), v) - labels.begin()) + 1;
+        priority[std::size_t(i)] = p;
+        ++voxels[p];
+      }
+  auto priorityAt = [&](const Voxel& v) -> std::uint32_t {
+    if (!dims.contains(v)) return 0;
+    return priority[std::size_t(v.x) + std::size_t(dims.nx) * (std::size_t(v.y) + std::size_t(dims.ny) * std::size_t(v.z))];
+  };
+
+  // 2. Each selected label's mesh, in grid edges.
+  struct Building {
+    std::unordered_map<std::uint64_t, std::uint32_t> vertexOf;  // grid edge key -> vertex
+    std::vector<Surfel> surfels;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+  };
+  std::vector<int> slot(labels.size() + 1, -1);  // priority -> index into building, -1 if not selected
+  std::vector<Building> building(selected.size());
+  for (std::size_t k = 0; k < selected.size(); ++k) slot[selected[k] + 1] = int(k);
+  std::unordered_map<std::uint32_t, CubeWalls> cache;  // by the corners' local ranks, 3 bits each
+  auto vertex = [&](Building& b, std::uint32_t label, const Voxel& m, int edge) {
+    const Voxel lo = m + cube::cornerOffset(cube::edgeLowCorner(edge));
+    const int axis = cube::edgeAxis(edge);
+    const std::uint64_t key = Surfel{lo, directionOf(axis, +1)}.key();
+    const auto [it, added] = b.vertexOf.try_emplace(key, std::uint32_t(b.surfels.size()));
+    if (added) {
+      // The label's own surfel has its voxel inside; a vertex of two other labels (a junction)
+      // is oriented from the one of higher priority.
+      const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
+      const std::uint32_t pl = priorityAt(lo), ph = priorityAt(hi);
+      const bool fromLow = pl == label || (ph != label && pl > ph);
+      b.surfels.push_back(fromLow ? Surfel{lo, directionOf(axis, +1)} : Surfel{hi, directionOf(axis, -1)});
+    }
+    return it->second;
+  };
+  for (int z = -1; z < dims.nz; ++z)
+    for (int y = -1; y < dims.ny; ++y)
+      for (int x = -1; x < dims.nx; ++x) {
+        const Voxel m{x, y, z};
+        std::array<std::uint32_t, 8> p;
+        for (int i = 0; i < 8; ++i) p[std::size_t(i)] = priorityAt(m + cube::cornerOffset(i));
+        std::array<std::uint32_t, 8> distinct = p;
+        std::sort(distinct.begin(), distinct.end());
+        const auto end = std::unique(distinct.begin(), distinct.end());
+        if (end - distinct.begin() == 1) continue;
+        std::array<std::uint8_t, 8> local;
+        std::uint32_t key = 0;
+        for (int i = 0; i < 8; ++i) {
+          local[std::size_t(i)] = std::uint8_t(std::lower_bound(distinct.begin(), end, p[std::size_t(i)]) - distinct.begin());
+          key |= std::uint32_t(local[std::size_t(i)]) << (3 * i);
+        }
+        auto at = cache.find(key);
+        if (at == cache.end()) at = cache.emplace(key, cubeWalls(local, o.pair)).first;
+        const CubeWalls& walls = at->second;
+        for (int w = 0; w < walls.count; ++w) {
+          const WallTriangle& t = walls.triangles[std::size_t(w)];
+          for (const bool reversed : {false, true}) {
+            const std::uint32_t label = distinct[reversed ? t.outside : t.inside];
+            if (slot[label] < 0) continue;
+            Building& b = building[std::size_t(slot[label])];
+            std::array<std::uint32_t, 3> tri{vertex(b, label, m, t.edges[0]), vertex(b, label, m, t.edges[1]),
+                                             vertex(b, label, m, t.edges[2])};
+            if (reversed) std::swap(tri[1], tri[2]);
+            b.triangles.push_back(tri);
+          }
+        }
+      }
+
+  // 3. Pinches split, vertices placed (midpoint mapping, then the geometry), figures.
+  const ImageGeometry geometry = source.geometry();
+  const bool mirrored = geometry.handedness() < 0;
+  std::vector<LabelSurface> out;
+  out.reserve(selected.size());
+  for (std::size_t k = 0; k < selected.size(); ++k) {
+    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+    Building& b = building[k];
+    std::vector<std::array<double, 3>> doubled(b.surfels.size());  // exact: 2 x the midpoint
+    for (std::size_t v = 0; v < b.surfels.size(); ++v) {
+      const Voxel c = b.surfels[v].inside(), d = b.surfels[v].outside();
+      doubled[v] = {double(c.x + d.x), double(c.y + d.y), double(c.z + d.z)};
+    }
+    PinchSplit split;
+    try {
+      split = splitPinches(doubled, b.triangles);
+    } catch (const std::logic_error& e) {
+      throw InternalError(std::string("shared walls: ") + e.what());
+    }
+    out.push_back(labelFields(geometry, LabelValue(labels[selected[k]]), voxels[selected[k] + 1], o));
+    LabelSurface& result = out.back();
+    Surface& s = result.surface;
+    s.surfels = std::move(b.surfels);
+    for (std::uint32_t v : split.copyOf) s.surfels.push_back(s.surfels[v]);
+    s.triangles = std::move(split.triangles);
+    s.vertices.resize(s.surfels.size());
+    for (std::size_t v = 0; v < s.surfels.size(); ++v) s.vertices[v] = geometry.toPhysical(MidpointMapping{}(s.surfels[v]));
+    requirePlacedVertices(geometry, s.vertices, [&](std::size_t v) { return MidpointMapping{}(s.surfels[v]); });
+    result.pinchCopies = split.copyOf.size();
+    result.pinchedEdges = split.pinchedEdges;
+    result.unsplitEdges = split.unsplitEdges;
+    if (!split.copyOf.empty() || split.pinchedEdges)
+      s.warnings.push_back("label " + result.label.text() + " touches itself: " + std::to_string(split.copyOf.size()) +
+                           " vertex copies, " + std::to_string(split.pinchedEdges) + " pinched edges, " +
+                           std::to_string(split.unsplitEdges) +
+                           " of them left with four triangles (docs/theory.md §12, pinches)");
+    finishScannedLabel(s, mirrored, o);
+  }
+  return out;
+}
+
+}  // namespace surftrack
