@@ -13,6 +13,8 @@ packages=(
   libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip streams)
   libdeflate-dev pkg-config      # io/: a .nii.gz inflated in one call
   libblosc-dev libzstd-dev       # io/: the chunks of zarr and N5 stores (blosc, zstd)
+  libdraco-dev                   # Draco: the fragments of Neuroglancer's multi-resolution meshes (converter/DracoFragment.cpp)
+  draco                          # draco_decoder: decodes every fragment independently in python/tests/test_precomputed_multires.py
   libcli11-dev                   # CLI11: the command line
   nlohmann-json3-dev             # nlohmann-json: the CLI's JSON output
   libtbb-dev                     # oneTBB: the scanning method on every core
