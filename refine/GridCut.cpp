@@ -83,8 +83,14 @@ void cutAlong(GridMesh& m, const OctreeGrid& grid, int axis) {
 
 }  // namespace
 
-GridMesh cutOnGrid(const GridMesh& mesh, const OctreeGrid& grid) {
+GridMesh cutOnGrid(const GridMesh& mesh, const OctreeGrid& grid, const std::array<double, 3>& snap) {
   GridMesh m = mesh;
+  for (auto& p : m.vertices)
+    for (int a = 0; a < 3; ++a) {
+      const double u = grid.cells(a, p[std::size_t(a)], 0), n = std::round(u);
+      if (u != n && std::abs(u - n) * grid.chunk[std::size_t(a)] <= snap[std::size_t(a)])
+        p[std::size_t(a)] = grid.plane(a, std::int64_t(n), 0);
+    }
   for (int axis = 0; axis < 3; ++axis) cutAlong(m, grid, axis);
   return m;
 }

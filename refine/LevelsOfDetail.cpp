@@ -33,7 +33,9 @@ OctreeGrid gridFor(const std::vector<std::array<double, 3>>& vertices, int lods)
 
 std::vector<GridMesh> levelsOfDetail(const GridMesh& mesh, const OctreeGrid& grid, const LevelsOfDetailOptions& o) {
   std::vector<GridMesh> levels;
-  levels.push_back(cutOnGrid(mesh, grid));
+  std::array<double, 3> snap{};
+  for (int a = 0; a < 3; ++a) snap[std::size_t(a)] = grid.chunk[std::size_t(a)] / (std::ldexp(1.0, o.quantizationBits) - 1);
+  levels.push_back(cutOnGrid(mesh, grid, snap));
   for (int k = 1; k < grid.lods; ++k) {
     const GridMesh& finer = levels.back();
     SurfaceMesh m;

@@ -21,6 +21,9 @@ struct LevelsOfDetailOptions {
   /// firstError * 2^(k-1), so level k lies within firstError * (2^k - 1) of level 0.
   double firstError = 0.5;
   double maxNormalDeviation = 60;  ///< degrees (TopologySafeDecimation.h)
+  /// The fragments' quantization (10 or 16 bits): a vertex within a step of level 0 from a
+  /// plane is snapped onto it before the cut (GridCut.h).
+  int quantizationBits = 16;
   const std::atomic<bool>* cancel = nullptr;
 };
 

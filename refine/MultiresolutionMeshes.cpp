@@ -30,6 +30,7 @@ void writeMultiresolutionMeshes(const std::vector<PrecomputedSegment>& segments,
   std::vector<MultiresSegment> out(segments.size());
   LevelsOfDetailOptions lo;
   lo.firstError = o.firstError;
+  lo.quantizationBits = o.quantizationBits;
   lo.cancel = o.cancel;
   tbb::parallel_for(std::size_t(0), segments.size(), [&](std::size_t i) {
     const PrecomputedSegment& s = segments[i];

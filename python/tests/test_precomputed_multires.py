@@ -312,9 +312,10 @@ def check_segment(m, bits, vertices, faces, tmp):
     v0, f0 = glue(m, 0, bits)
     assert area(v0, f0) == pytest.approx(area(vertices, faces), rel=1e-3)
     assert volume(v0, f0) == pytest.approx(volume(vertices, faces), rel=1e-3)
-    # Every vertex of the mesh is a vertex of level 0, up to half a step; the others are on its edges.
+    # Every vertex of the mesh is a vertex of level 0, up to half a step (one more if the cut
+    # snapped it onto a plane, GridCut.h); the others are on its edges.
     d = np.abs(vertices[:, None, :] - v0[None, :, :]) / step
-    near = (d <= 0.5 + 1e-6).all(axis=2)
+    near = (d <= 1.5 + 1e-6).all(axis=2)
     assert near.any(axis=1).all()
     others = v0[~near.any(axis=0)]
     if len(others):
@@ -323,7 +324,7 @@ def check_segment(m, bits, vertices, faces, tmp):
         t = np.clip(np.einsum("ekj,ej->ek", others[None] - p[:, None], q - p) / np.einsum("ej,ej->e", q - p, q - p)[:, None], 0, 1)
         closest = p[:, None] + t[..., None] * (q - p)[:, None]
         dist = np.abs(closest - others[None]).max(axis=2).min(axis=0) / step.min()
-        assert dist.max() <= 1.0
+        assert dist.max() <= 2.0
 
 
 # --- the tests -----------------------------------------------------------------------------------
@@ -369,6 +370,21 @@ def test_levels_are_closed_oriented_and_match_the_label(tmp_path, bits, lods, sh
             # The stored coordinates are voxel units: the vertices divided by the spacing.
             vertices = np.asarray(s.vertices, float) / np.asarray(spacing)
             check_segment(m, bits, vertices, np.asarray(s.faces), tmp_path)
+
+
+def test_smoothed_surface_of_genus_two(tmp_path):
+    # Smoothed vertices lie anywhere on their segments, near the grid's planes too.
+    volume = np.maximum(torus((18, 30, 30), (9, 15, 9), 5, 2.2, 200), torus((18, 30, 30), (9, 15, 20), 5, 2.2, 200))
+    s = surftrack.extract(volume.astype(np.uint8), level=100, smooth=20)
+    closed, euler, components = topology(np.asarray(s.vertices, float), np.asarray(s.faces))
+    assert closed and components == 1 and euler == -2  # genus 2
+    # (16 bits: smoothed vertices can come closer than the coarse levels' 10-bit steps, where
+    # the quantization would merge them, which the glue here cannot tell from a defect.)
+    out = tmp_path / "m"
+    surftrack.write_precomputed({1: s}, out, axes="zyx", lods=3)
+    info = json.loads((out / "info").read_text())
+    m = load_segment(out, info, 1, tmp_path)
+    check_segment(m, 16, np.asarray(s.vertices, float), np.asarray(s.faces), tmp_path)
 
 
 def transform_of(info):
