@@ -39,3 +39,12 @@ if ((${#missing[@]})); then
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}" >/dev/null
 fi
+
+# draco3d from npm (Google's Emscripten build of Draco): a second decoder of the multi-resolution
+# fragments, independent of Debian's libdraco that writes them
+# (python/tests/test_precomputed_multires.py; skipped there when node or the package is missing).
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+if command -v npm >/dev/null && [[ ! -d "$root/python/tests/node/node_modules/draco3d" ]]; then
+  echo "setup: installing draco3d (npm) in python/tests/node" >&2
+  npm install --silent --no-audit --no-fund --prefix "$root/python/tests/node" >/dev/null
+fi

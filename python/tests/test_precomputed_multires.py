@@ -29,6 +29,8 @@ import surftrack
 
 CLI = os.environ.get("SURFTRACK_CLI")
 DRACO = shutil.which("draco_decoder")
+NODE_DIR = os.path.join(os.path.dirname(__file__), "node")
+NODE = shutil.which("node") if os.path.isdir(os.path.join(NODE_DIR, "node_modules", "draco3d")) else None
 pytestmark = pytest.mark.skipif(DRACO is None, reason="draco_decoder (Debian package draco) not installed")
 
 
@@ -194,11 +196,45 @@ def load_segment(path, info, segid, tmp):
         for i in range(len(m["positions"][lod])):
             size = m["sizes"][sum(len(p) for p in m["positions"][:lod]) + i]
             level.append(draco_decode(data[at:at + size], tmp) if size else None)
+            if size and NODE:
+                (tmp / f"n{lod}_{i}.drc").write_bytes(data[at:at + size])
             at += size
         fragments.append(level)
+    if NODE:
+        check_second_decoder(fragments, tmp)
     m["fragments"] = fragments
     m["manifest_bytes"], m["data_bytes"] = manifest, data
     return m
+
+
+def triangles_by_position(positions, faces):
+    """The triangles as sorted rows of their corners' points, each rotated to start at its
+    smallest corner (orientation kept): independent of how a decoder numbers the points."""
+    t = positions[faces]  # (M, 3, 3)
+    keys = [tuple(map(tuple, tri)) for tri in t.tolist()]
+    rotated = []
+    for a, b, c in keys:
+        r = min([(a, b, c), (b, c, a), (c, a, b)])
+        rotated.append(r)
+    return sorted(rotated)
+
+
+def check_second_decoder(fragments, tmp):
+    """Every fragment decoded again by npm's draco3d under node: the same triangles, the same
+    orientation, as Debian's draco_decoder gives."""
+    names = [(lod, i) for lod, level in enumerate(fragments) for i, f in enumerate(level) if f is not None]
+    run = subprocess.run([NODE, os.path.join(NODE_DIR, "draco3d_decode.js"),
+                          *[str(tmp / f"n{lod}_{i}.drc") for lod, i in names]],
+                         capture_output=True, text=True, cwd=NODE_DIR)
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()
+    assert len(lines) == len(names)
+    for (lod, i), line in zip(names, lines):
+        d = json.loads(line)
+        p = np.asarray(d["positions"], np.int64).reshape(-1, 3)
+        f = np.asarray(d["faces"], np.int64).reshape(-1, 3)
+        q, g = fragments[lod][i]
+        assert triangles_by_position(p, f) == triangles_by_position(q, g), (lod, i)
 
 
 # --- checks of one level -------------------------------------------------------------------------
