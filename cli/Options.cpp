@@ -785,6 +785,8 @@ MeshOptions parseMeshOptions(const std::vector<std::string>& args) {
     throw UsageError("--mapping linear interpolates an iso-value: it needs --iso, not --label");
   if (o.format.empty() && (!o.unit.empty() || app.get_option("--id")->count() > 0))
     throw UsageError("--unit and --id are for --format precomputed or precomputed-multires");
+  if (o.id.negative() || o.id == LabelValue(0))
+    throw UsageError("--id " + o.id.text() + ": Neuroglancer's segment ids are positive uint64 values");
   checkPrecomputedOptions(app, o.format, o.output);
   checkRaw(o.input, a.input);
   return o;
