@@ -28,12 +28,6 @@ std::uint64_t zOrder(const Cell& c) {
   return key;
 }
 
-double determinant(const ToNanometres& m) {
-  const auto& a = m.linear;
-  return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-         a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-}
-
 struct Encoded {
   std::string manifest, data;
 };
@@ -184,7 +178,7 @@ void writePrecomputedMultires(const std::vector<MultiresSegment>& segments, cons
   if (format.quantizationBits != 10 && format.quantizationBits != 16)
     throw std::invalid_argument("vertex quantization bits must be 10 or 16 (the format allows no other), not " +
                                 std::to_string(format.quantizationBits));
-  const double det = determinant(toNanometres);
+  const double det = toNanometres.determinant();
   if (!std::isfinite(det) || det == 0)
     throw std::invalid_argument("the map of the meshes to nanometres is singular or not finite");
   std::vector<std::pair<LabelValue, const std::string*>> ids;

@@ -37,9 +37,7 @@ std::string fragmentBytes(const PrecomputedSegment& s, const ToNanometres& m) {
   }
   // A map that mirrors (negative determinant, e.g. array columns z, y, x read as x, y, z) would
   // turn the triangles inwards: they are written reversed, still facing out of the label.
-  const auto& a = m.linear;
-  const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                     a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+  const double det = m.determinant();
   for (std::array<std::uint32_t, 3> t : triangles) {
     if (det < 0) std::swap(t[1], t[2]);
     for (std::uint32_t v : t) {
@@ -57,9 +55,7 @@ std::string fragmentBytes(const PrecomputedSegment& s, const ToNanometres& m) {
 void writePrecomputedMeshes(const std::vector<PrecomputedSegment>& segments, const std::string& directory,
                             const ToNanometres& toNanometres) {
   const fs::path target = precomputedTarget(directory);
-  const auto& a = toNanometres.linear;
-  const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                     a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+  const double det = toNanometres.determinant();
   if (!std::isfinite(det) || det == 0)
     throw std::invalid_argument("the map of the meshes to nanometres is singular or not finite");
   std::vector<std::pair<LabelValue, const std::string*>> ids;
