@@ -163,17 +163,12 @@ def draco_decode(data, tmp):
     return v.astype(np.int64), np.array(faces, np.int64).reshape(-1, 3)
 
 
-def read_multires(path, tmp):
-    """info, {segid: manifest fields + 'fragments': [lod][node] -> (positions, faces)}."""
+def read_info(path):
     info = json.loads((path / "info").read_text())
     assert info["@type"] == "neuroglancer_multilod_draco"
     assert info["vertex_quantization_bits"] in (10, 16) and len(info["transform"]) == 12
-    segments = {}
-    if "sharding" in info:
-        ids = None
-    else:
-        ids = [int(n[:-6]) for n in os.listdir(path) if n.endswith(".index")]
-    return info, segments, ids
+    assert info["lod_scale_multiplier"] > 0
+    return info
 
 
 def load_segment(path, info, segid, tmp):
@@ -394,7 +389,7 @@ def test_levels_are_closed_oriented_and_match_the_label(tmp_path, bits, lods, sh
         surftrack.write_precomputed(surfaces, out, axes="zyx", unit="um", spacing=spacing,
                                     lods=lods, sharded=sharded, quantization_bits=bits,
                                     names={9: "torus"})
-        info = json.loads((out / "info").read_text())
+        info = read_info(out)
         assert info["vertex_quantization_bits"] == bits and ("sharding" in info) == sharded
         if not sharded:
             assert sorted(int(n[:-6]) for n in os.listdir(out) if n.endswith(".index")) == sorted(surfaces)
@@ -418,7 +413,7 @@ def test_smoothed_surface_of_genus_two(tmp_path):
     # the quantization would merge them, which the glue here cannot tell from a defect.)
     out = tmp_path / "m"
     surftrack.write_precomputed({1: s}, out, axes="zyx", lods=3)
-    info = json.loads((out / "info").read_text())
+    info = read_info(out)
     m = load_segment(out, info, 1, tmp_path)
     check_segment(m, 16, np.asarray(s.vertices, float), np.asarray(s.faces), tmp_path)
 
@@ -440,7 +435,7 @@ def test_transform_puts_level_zero_where_the_legacy_format_puts_the_mesh(tmp_pat
     surfaces = surftrack.label_surfaces(labels, spacing=spacing)
     surftrack.write_precomputed(surfaces, tmp_path / "legacy", axes="zyx", unit="um", spacing=spacing)
     surftrack.write_precomputed(surfaces, tmp_path / "multi", axes="zyx", unit="um", spacing=spacing, lods=2)
-    info = json.loads((tmp_path / "multi" / "info").read_text())
+    info = read_info(tmp_path / "multi")
     m = load_segment(tmp_path / "multi", info, 3, tmp_path)
     v0, _ = glue(m, 0, 16)
     nm = transform_of(info)(v0)
@@ -458,8 +453,8 @@ def test_sharded_and_unsharded_hold_the_same_segments(tmp_path):
     surfaces = surftrack.label_surfaces(labels)
     surftrack.write_precomputed(surfaces, tmp_path / "u", axes="zyx", lods=2)
     surftrack.write_precomputed(surfaces, tmp_path / "s", axes="zyx", lods=2, sharded=True)
-    iu = json.loads((tmp_path / "u" / "info").read_text())
-    is_ = json.loads((tmp_path / "s" / "info").read_text())
+    iu = read_info(tmp_path / "u")
+    is_ = read_info(tmp_path / "s")
     assert not any(n.endswith(".index") for n in os.listdir(tmp_path / "s"))
     assert all(n.endswith(".shard") or n == "info" for n in os.listdir(tmp_path / "s"))
     for segid in surfaces:
@@ -476,7 +471,7 @@ def test_many_labels_spread_over_minishards_by_the_hash(tmp_path):
         labels[3 * z:3 * z + 2, 3 * y:3 * y + 2, 3 * x:3 * x + 2] = ids[n]
     surfaces = surftrack.label_surfaces(labels)
     surftrack.write_precomputed(surfaces, tmp_path / "s", axes="zyx", lods=1, sharded=True)
-    info = json.loads((tmp_path / "s" / "info").read_text())
+    info = read_info(tmp_path / "s")
     assert info["sharding"]["minishard_bits"] + info["sharding"]["shard_bits"] >= 1
     total = 0
     for segid, surface in surfaces.items():
@@ -534,7 +529,7 @@ def test_cli_labels_and_mesh(tmp_path):
         run = subprocess.run([CLI, "labels", str(raw), *base, "--format", "precomputed-multires", "--lods", "2",
                               *extra, "-o", str(out) + "/"], capture_output=True, text=True)
         assert run.returncode == 0, run.stderr
-        info = json.loads((out / "info").read_text())
+        info = read_info(out)
         t = np.asarray(info["transform"]).reshape(3, 4)
         # Voxel indices to nanometres: the spacing, and half a voxel (voxel i over [i, i + 1)).
         assert np.allclose(t[:, :3], np.diag([4, 5, 40])) and np.allclose(t[:, 3], [2, 2.5, 20])
@@ -546,7 +541,7 @@ def test_cli_labels_and_mesh(tmp_path):
     run = subprocess.run([CLI, "mesh", str(raw), *base, "--label", "4", "--format", "precomputed-multires",
                           "--id", "12", "-o", str(out) + "/"], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    info = json.loads((out / "info").read_text())
+    info = read_info(out)
     assert sorted(os.listdir(out)) == ["12", "12.index", "info"]
     run = subprocess.run([CLI, "mesh", str(raw), *base, "--label", "4", "--format", "precomputed",
                           "-o", str(tmp_path / "legacy") + "/"], capture_output=True, text=True)
