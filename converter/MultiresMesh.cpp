@@ -41,7 +41,7 @@ class SegmentEncoder {
     const int lods = g.lods;
     // The nodes of each level: the cells its triangles lie in, and the parents of the nodes
     // of the level below (Neuroglancer reaches a node only through its parent).
-    std::vector<std::map<std::uint64_t, std::pair<Cell, std::vector<std::uint32_t>>>> nodes(std::size_t(lods));
+    std::vector<std::map<std::uint64_t, std::pair<Cell, std::vector<std::uint32_t>>>> nodes(static_cast<std::size_t>(lods));
     for (int k = 0; k < lods; ++k) {
       const MultiresLevel& level = s_.levels[std::size_t(k)];
       for (std::uint32_t t = 0; t < level.triangles.size(); ++t) {
