@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 
 import surftrack
+from conftest import closed_oriented_manifold
 
 CLI = os.environ.get("SURFTRACK_CLI")
 DRACO = shutil.which("draco_decoder")
@@ -300,25 +301,6 @@ def topology(vertices, faces):
     return closed, euler, components
 
 
-def manifold_vertices(faces):
-    """Every vertex's triangles form one fan (no pinched vertex)."""
-    nxt = {}
-    for a, b, c in faces.tolist():
-        for u, v, w in ((a, b, c), (b, c, a), (c, a, b)):
-            nxt.setdefault(u, {})[v] = w  # around u: from v to w
-    for u, ring in nxt.items():
-        start = next(iter(ring))
-        v, steps = start, 0
-        while True:
-            v = ring[v]
-            steps += 1
-            if v == start:
-                break
-        if steps != len(ring):
-            return False
-    return True
-
-
 def volume(vertices, faces):
     t = vertices[faces]
     return np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])).sum() / 6
@@ -341,7 +323,7 @@ def check_segment(m, info, vertices, faces):
         v, f = glue(m, lod, bits)
         c, e, k = topology(v, f)
         assert c and e == euler and k == components, (lod, c, e, euler, k, components)
-        assert manifold_vertices(f), lod
+        assert closed_oriented_manifold(f, len(v)), lod
         assert mirror * volume(v, f) > 0, lod
     step = m["chunk"] / ((1 << bits) - 1)  # level 0's quantization step, per axis
     v0, f0 = glue(m, 0, bits)
