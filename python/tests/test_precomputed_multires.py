@@ -24,6 +24,7 @@ import subprocess
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 import surftrack
 from conftest import closed_oriented_manifold
@@ -334,12 +335,15 @@ def check_segment(m, info, vertices, faces):
     assert mirror * volume(v0, f0) == pytest.approx(volume(vertices, faces), abs=1.5 * step.max() * a + 1e-9)
     # Every vertex of the mesh is a vertex of level 0, up to half a step (one more if the cut
     # snapped it onto a plane, GridCut.h); the others lie on its triangles (the cut's points).
-    d = np.abs(vertices[:, None, :] - v0[None, :, :]) / step
-    near = (d <= 1.5 + 1e-6).all(axis=2)
-    assert near.any(axis=1).all()
-    others = v0[~near.any(axis=0)]
-    if len(others):
-        assert distance_to_triangles(others, vertices[faces]).max() <= 2 * step.max()
+    tree = cKDTree(v0 / step)
+    d, _ = tree.query(vertices / step, p=np.inf)
+    assert d.max() <= 1.5 + 1e-6
+    hit = np.zeros(len(v0), bool)
+    for near in tree.query_ball_point(vertices / step, 1.5 + 1e-6, p=np.inf):
+        hit[near] = True
+    others = v0[~hit]
+    for start in range(0, len(others), 256):  # in pieces: (points, triangles) arrays stay small
+        assert distance_to_triangles(others[start:start + 256], vertices[faces]).max() <= 2 * step.max()
 
 
 def distance_to_triangles(points, triangles):
