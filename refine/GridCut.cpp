@@ -12,7 +12,14 @@ namespace {
 /// One axis: every triangle split on the planes strictly inside its span. Each edge crossed
 /// gets its new vertices once (keyed by its two ends), in order of increasing plane, so that
 /// the two triangles of an edge share them and the mesh stays conforming.
-void cutAlong(GridMesh& m, const OctreeGrid& grid, int axis) {
+void cutAlong(GridMesh& m, const OctreeGrid& grid, int axis, double snap) {
+  // The snap, for the vertices of the earlier passes too: theirs interpolate this coordinate,
+  // and one a rounding error off a plane would be cut into needles.
+  for (auto& p : m.vertices) {
+    const double u = grid.cells(axis, p[std::size_t(axis)], 0), n = std::round(u);
+    if (u != n && std::abs(u - n) * grid.chunk[std::size_t(axis)] <= snap)
+      p[std::size_t(axis)] = grid.plane(axis, std::int64_t(n), 0);
+  }
   std::vector<double> u(m.vertices.size());
   for (std::size_t v = 0; v < u.size(); ++v) u[v] = grid.cells(axis, m.vertices[v][axis], 0);
   std::unordered_map<std::uint64_t, std::uint32_t> firstCut;  // edge (low, high) -> its first new vertex
@@ -85,13 +92,7 @@ void cutAlong(GridMesh& m, const OctreeGrid& grid, int axis) {
 
 GridMesh cutOnGrid(const GridMesh& mesh, const OctreeGrid& grid, const std::array<double, 3>& snap) {
   GridMesh m = mesh;
-  for (auto& p : m.vertices)
-    for (int a = 0; a < 3; ++a) {
-      const double u = grid.cells(a, p[std::size_t(a)], 0), n = std::round(u);
-      if (u != n && std::abs(u - n) * grid.chunk[std::size_t(a)] <= snap[std::size_t(a)])
-        p[std::size_t(a)] = grid.plane(a, std::int64_t(n), 0);
-    }
-  for (int axis = 0; axis < 3; ++axis) cutAlong(m, grid, axis);
+  for (int axis = 0; axis < 3; ++axis) cutAlong(m, grid, axis, snap[std::size_t(axis)]);
   return m;
 }
 

@@ -21,9 +21,10 @@ struct GridMesh {
 /// `mesh` cut on the planes of `grid`'s level 0, along x, then y, then z. A new vertex lies
 /// exactly on its plane (its coordinate is the plane's); the old vertices keep their indices
 /// and, but for the snap, their points; the new ones follow them. A triangle lying in a plane
-/// is kept whole. First a vertex within `snap[a]` (but not on) a plane along axis a is moved
-/// onto it: no new vertex then lies within that distance of an old one along the axis, so that
-/// quantizing with steps of snap[a] keeps them apart.
+/// is kept whole. Before the cut along axis a, a vertex within `snap[a]` of a plane along it
+/// (an old one, or one an earlier axis made, whose coordinate is interpolated) is moved onto
+/// it: no new vertex then lies within that distance of an old one along the axis (no needle
+/// triangles), and quantizing with steps of snap[a] keeps them apart.
 GridMesh cutOnGrid(const GridMesh& mesh, const OctreeGrid& grid, const std::array<double, 3>& snap = {});
 
 }  // namespace surftrack::refine
