@@ -1,7 +1,6 @@
 // A Decimater module (OpenMesh) that keeps a mesh cut on the planes of one level of an octree
-// grid (docs/theory.md, section 10, "Levels of detail on
-// a grid"), so that a decimated level of detail meets its finer levels
-// on exactly the same curves there:
+// grid (docs/theory.md, section 10, "Levels of detail on a grid"), so that a decimated level of
+// detail meets its finer levels on exactly the same curves there:
 //  - a vertex on such a plane is never the removed vertex v0 of a collapse (its point, and so
 //    the curve the surface cuts on the plane, stays), and
 //  - no collapse creates a triangle lying in such a plane (Neuroglancer could not tell on which
