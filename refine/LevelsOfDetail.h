@@ -1,7 +1,8 @@
 // Levels of detail of a closed surface on an octree grid, for Neuroglancer's multi-resolution
 // format (docs/theory.md, section 10, "Levels of detail on a grid"): level 0 is the surface cut
-// on level 0's planes (GridCut.h); level k > 0 is level k - 1 decimated topology-safely (TopologySafeDecimation.h)
-// with the vertices on level k - 1's planes kept (GridLockGuard.h). So every level is a closed
+// on level 0's planes (GridCut.h); level k > 0 is level k - 1 decimated topology-safely
+// (TopologySafeDecimation.h) with the vertices on level k - 1's planes kept (GridLockGuard.h).
+// So every level is a closed
 // oriented manifold with the components and genus of the surface, cut as the format wants, and
 // on every plane of level j's grid all levels 0 .. j + 1 cut the same curve: where Neuroglancer
 // draws two levels side by side (always on such a plane) their meshes meet without a crack.
