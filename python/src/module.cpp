@@ -716,7 +716,7 @@ void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> 
 /// (converter/PrecomputedMesh.h, or with lods > 0 the multi-resolution format of
 /// refine/MultiresolutionMeshes.h); `linear` and `offset` map the vertices to nanometres.
 void writePrecomputed(const py::list& segments, const std::string& path, std::array<std::array<double, 3>, 3> linear,
-                      std::array<double, 3> offset, int lods, int quantizationBits, bool sharded) {
+                      std::array<double, 3> offset, int lods, int quantizationBits, int sharding) {
   std::vector<std::vector<std::array<double, 3>>> vertices(segments.size());
   std::vector<std::vector<std::array<std::uint32_t, 3>>> triangles(segments.size());
   std::vector<PrecomputedSegment> out;
@@ -744,7 +744,8 @@ void writePrecomputed(const py::list& segments, const std::string& path, std::ar
       refine::MultiresolutionOptions o;
       o.lods = lods;
       o.quantizationBits = quantizationBits;
-      o.sharded = sharded;
+      o.sharded = sharding != 0;  // 1: murmurhash3_x86_128, 2: identity
+      o.identityHash = sharding == 2;
       std::atomic<bool> cancel{false};
       o.cancel = &cancel;
       runWatchingSignals(cancel, [&] { refine::writeMultiresolutionMeshes(out, path, ToNanometres{linear, offset}, o); });

@@ -17,7 +17,7 @@ _UNITS = {"nm": 1.0, "um": 1e3, "µm": 1e3, "mm": 1e6, "cm": 1e7, "m": 1e9}
 
 
 def write_precomputed(surfaces: dict, path, *, axes: str, unit: str = "nm", spacing=None,
-                      names: dict | None = None, lods: int | None = None, sharded: bool = False,
+                      names: dict | None = None, lods: int | None = None, sharded: bool | str = False,
                       quantization_bits: int = 16) -> None:
     """Writes ``surfaces`` (label -> an object with ``vertices`` and ``faces``) to the directory
     ``path`` (absent or empty; written whole or not at all).
@@ -35,7 +35,8 @@ def write_precomputed(surfaces: dict, path, *, axes: str, unit: str = "nm", spac
     each a closed oriented mesh of the label's genus (level k within 0.5 (2^k - 1) voxels of
     level 0, the voxel being ``spacing``, or a vertex unit without it), every surface then
     needing to be closed and oriented. ``sharded``: the sharded layout (a few ``.shard`` files
-    instead of two files per label). ``quantization_bits``: 16 (default) or 10, the fragments'
+    instead of two files per label), its ids hashed by ``"murmurhash3_x86_128"`` (``True``) or
+    not (``"identity"``: consecutive ids share minishards). ``quantization_bits``: 16 (default) or 10, the fragments'
     vertex precision (a level-k fragment of a cell of c voxels has steps of c 2^k / (2^bits - 1)).
     Raises ValueError for a label that is not a positive uint64, coordinates beyond float32
     nanometres, a multi-resolution option out of range or a surface that is not closed;
@@ -57,6 +58,8 @@ def write_precomputed(surfaces: dict, path, *, axes: str, unit: str = "nm", spac
         lods = 0
     elif isinstance(lods, bool) or not isinstance(lods, (int, np.integer)) or not 1 <= lods <= 10:
         raise ValueError(f"lods must be an int from 1 to 10, not {lods!r}")
+    if sharded not in (False, True, "murmurhash3_x86_128", "identity"):
+        raise ValueError(f"sharded must be False, True, 'murmurhash3_x86_128' or 'identity', not {sharded!r}")
     if quantization_bits not in (10, 16):
         raise ValueError(f"quantization_bits must be 10 or 16, not {quantization_bits!r}")
     order = [0, 1, 2] if axes == "xyz" else [2, 1, 0]  # Neuroglancer's axis r is column order[r]
@@ -74,5 +77,5 @@ def write_precomputed(surfaces: dict, path, *, axes: str, unit: str = "nm", spac
             raise TypeError(f"a segment id is an integer, not {label!r}")
         segments.append((int(label), np.asarray(surface.vertices, dtype=np.float64) / scale,
                          np.asarray(surface.faces, dtype=np.int64), str(names.get(label, ""))))
-    _surftrack.write_precomputed(segments, str(path), linear, offset, int(lods), int(quantization_bits),
-                                 bool(sharded))
+    hashing = {False: 0, True: 1, "murmurhash3_x86_128": 1, "identity": 2}[sharded]
+    _surftrack.write_precomputed(segments, str(path), linear, offset, int(lods), int(quantization_bits), hashing)

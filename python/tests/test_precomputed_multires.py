@@ -463,15 +463,20 @@ def test_sharded_and_unsharded_hold_the_same_segments(tmp_path):
     labels[labels > 0] += np.uint64(2**40)
     surfaces = surftrack.label_surfaces(labels)
     surftrack.write_precomputed(surfaces, tmp_path / "u", axes="zyx", lods=2)
-    surftrack.write_precomputed(surfaces, tmp_path / "s", axes="zyx", lods=2, sharded=True)
-    iu = read_info(tmp_path / "u")
-    is_ = read_info(tmp_path / "s")
-    assert not any(n.endswith(".index") for n in os.listdir(tmp_path / "s"))
-    assert all(n.endswith(".shard") or n == "info" for n in os.listdir(tmp_path / "s"))
-    for segid in surfaces:
-        manifest, data = read_sharded(str(tmp_path / "s"), is_, segid)
-        assert manifest == (tmp_path / "u" / f"{segid}.index").read_bytes()
-        assert data == (tmp_path / "u" / str(segid)).read_bytes()
+    read_info(tmp_path / "u")
+    for hashing in (True, "identity"):
+        out = tmp_path / f"s-{hashing}"
+        surftrack.write_precomputed(surfaces, out, axes="zyx", lods=2, sharded=hashing)
+        info = read_info(out)
+        assert info["sharding"]["hash"] == ("identity" if hashing == "identity" else "murmurhash3_x86_128")
+        assert not any(n.endswith(".index") for n in os.listdir(out))
+        assert all(n.endswith(".shard") or n == "info" for n in os.listdir(out))
+        for segid in surfaces:
+            manifest, data = read_sharded(str(out), info, segid)
+            assert manifest == (tmp_path / "u" / f"{segid}.index").read_bytes()
+            assert data == (tmp_path / "u" / str(segid)).read_bytes()
+    with pytest.raises(ValueError, match="sharded"):
+        surftrack.write_precomputed(surfaces, tmp_path / "x", axes="zyx", lods=2, sharded="md5")
 
 
 def test_many_labels_spread_over_minishards_by_the_hash(tmp_path):
