@@ -19,7 +19,7 @@
 #include "Labels.h"
 #include "MeshIO.h"
 #include "OutputFile.h"
-#include "PrecomputedMesh.h"
+#include "PrecomputedOutput.h"
 #include "Report.h"
 
 namespace surftrack::cli {
@@ -67,43 +67,11 @@ std::string tableText(const std::string& path, const std::vector<LabelRow>& rows
   return fs::path(path).extension() == ".json" ? jsonText(labelTableJson(rows)) + "\n" : labelTableCsv(rows);
 }
 
-/// Nanometres per unit of a unit name (--unit, or as the volume's file states it); 0: not a
-/// length known here.
-double nanometresPer(const std::string& unit) {
-  static const std::map<std::string, double> units = {
-      {"nm", 1.0}, {"um", 1e3}, {"µm", 1e3}, {"mm", 1e6}, {"cm", 1e7}, {"m", 1e9}, {"Å", 0.1}, {"inch", 2.54e7}};
-  const auto it = units.find(unit);
-  return it == units.end() ? 0.0 : it->second;
-}
-
-/// The map from the volume's physical coordinates to Neuroglancer's nanometres: the unit's
-/// scale, and half a voxel along each voxel axis, because Neuroglancer draws voxel i over
-/// [i, i + 1) where the physical coordinates put its centre at i (docs/cli.md, "Neuroglancer
-/// output").
-ToNanometres toNanometres(const io::LoadedVolume& volume, const LabelsOptions& o) {
-  std::string unit = o.unit;
-  if (unit.empty()) unit = volume.unit;
-  if (unit.empty() && volume.format != "raw") unit = "mm";  // ITK's unit for medical formats
-  if (unit.empty())
-    throw UsageError("the spacing of a raw file has no unit: give --unit (nm, um, mm, cm or m) for --format precomputed");
-  const double k = nanometresPer(unit);
-  if (k == 0) throw UsageError("the volume's unit '" + unit + "' is not a length: give --unit (nm, um, mm, cm or m)");
-  const ImageGeometry& g = volume.view.geometry;
-  ToNanometres m;
-  for (int r = 0; r < 3; ++r) {
-    m.linear[r] = {r == 0 ? k : 0.0, r == 1 ? k : 0.0, r == 2 ? k : 0.0};
-    double shift = 0;
-    for (int e = 0; e < 3; ++e) shift += g.direction[r][e] * g.spacing[e] / 2;
-    m.offset[r] = k * shift;
-  }
-  return m;
-}
-
 }  // namespace
 
 LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   // Everything that can be checked before the work is.
-  const bool precomputed = o.format == "precomputed";
+  const bool precomputed = !o.format.empty();  // precomputed, precomputed-multires
   const OutputKind kind = precomputed ? OutputKind::Directory : outputKind(o.output);
   if (kind == OutputKind::Pattern) {
     meshFormat(o.output);
@@ -195,7 +163,9 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
       r.volume += c.volume;
     }
     if (precomputed) {
-      r.file = (fs::path(o.output) / (r.label.text() + ":0")).string();  // the segment's manifest
+      // The segment's manifest (unsharded; sharded, the shard file holds it).
+      r.file = o.precomputed.sharded ? o.output
+               : (fs::path(o.output) / (r.label.text() + (o.format == "precomputed" ? ":0" : ".index"))).string();
     } else if (kind != OutputKind::OnePly) {
       std::string file = kind == OutputKind::Pattern ? o.output
                          : names.empty()             ? (fs::path(o.output) / "label_{label}.ply").string()
@@ -212,13 +182,13 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
 
   const bool binary = !o.ascii;
   if (precomputed) {
-    const ToNanometres m = toNanometres(volume, o);
-    std::vector<PrecomputedSegment> segments;
+    std::vector<OutputSegment> segments;
     for (const LabelSurface& ls : surfaces) {  // named segments only where names were given
       const auto named = names.find(ls.label);
-      segments.push_back({ls.label, &ls.surface.vertices, &ls.surface.triangles, named == names.end() ? "" : named->second});
+      segments.push_back({ls.label, &ls.surface, named == names.end() ? "" : named->second});
     }
-    writePrecomputedMeshes(segments, o.output, m);
+    writePrecomputedOutput(segments, o.output, o.format, volume.view.geometry, {o.unit, volume.unit, volume.format},
+                           o.precomputed);
   } else if (kind == OutputKind::OnePly) {
     writeLabelSurfaces(surfaces, o.output, binary);
   } else {

@@ -9,6 +9,7 @@
 #include "DaskJob.h"
 #include "Extraction.h"
 #include "OutputFile.h"
+#include "PrecomputedOutput.h"
 #include "Report.h"
 
 namespace surftrack::cli {
@@ -17,7 +18,8 @@ namespace {
 
 /// A seeded extraction with --iso or --label from a chunked store, read lazily: only the chunks
 /// the surface crosses are decoded, through a cache of --cache MiB (docs/cli.md, "Input formats").
-void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progress& progress, int stages) {
+void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progress& progress, int stages,
+                   SpacingUnit& unit) {
   const io::ChunkedStore store = io::openChunkedStore(o.input.path, chunkedStoreOptions(o.input));
   const auto cache = std::make_shared<const ChunkCache>(store.provider, std::size_t(o.cacheMiB) << 20);
   const ChunkLayout& layout = cache->layout();
@@ -27,6 +29,8 @@ void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progr
   const VoxelSource& source = *chunked;
   clock.lap(x.timings, "read");
   x.input = o.input.path;
+  unit.fileUnit = store.unit;
+  unit.fileFormat = store.format;
   x.dims = layout.dims;
   x.type = layout.type;
   x.geometry = geometry;
@@ -40,6 +44,14 @@ void extractLazily(const MeshOptions& o, Extraction& x, StageClock& clock, Progr
   x.chunks = cache->counters();
   x.voxelBytesRead = std::min<std::uintmax_t>(
       x.chunks->chunksDecoded * std::uint64_t(layout.chunk.count()) * sizeOf(layout.type), x.voxelBytes);
+}
+
+/// The bytes of the files under `directory` (a Neuroglancer output).
+std::uintmax_t directoryBytes(const std::string& directory) {
+  std::uintmax_t total = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(directory))
+    if (entry.is_regular_file()) total += entry.file_size();
+  return total;
 }
 
 }  // namespace
@@ -83,11 +95,17 @@ int runMesh(const std::vector<std::string>& args) {
   const MeshOptions o = parseMeshOptions(args);
   Extraction x;
   x.output = o.output;
-  x.format = meshFormat(o.output);  // a usage error, before any work
+  const bool precomputed = !o.format.empty();  // a Neuroglancer directory
+  x.format = precomputed ? o.format : meshFormat(o.output);  // a usage error, before any work
   x.binary = !o.ascii && (x.format == "ply" || x.format == "stl");
-  requireWritable(o.output);        // fail now rather than after the work
-  requireNotInput(o.output, o.input.path);
+  if (precomputed) {
+    requireOutputDirectory(o.output);
+  } else {
+    requireWritable(o.output);  // fail now rather than after the work
+    requireNotInput(o.output, o.input.path);
+  }
   if (!o.dask.empty()) return meshAllOnDask(o, x.binary);
+  SpacingUnit unit{o.unit, "", ""};
 
   Progress progress(Progress::wanted(o.out.quiet));
   StageClock clock;
@@ -97,18 +115,25 @@ int runMesh(const std::vector<std::string>& args) {
   const bool seeded = o.surface.seedMode != SeedMode::Largest && o.surface.seedMode != SeedMode::All;
   const bool sparse = seeded && (o.surface.iso || o.surface.label);
   if (sparse && isChunkedInput(o.input)) {
-    extractLazily(o, x, clock, progress, stages);
+    extractLazily(o, x, clock, progress, stages, unit);
   } else {
     const io::LoadedVolume volume = readInput(o.input);
     clock.lap(x.timings, "read");
     describeInput(volume, o.input.path, x);
+    unit.fileUnit = volume.unit;
+    unit.fileFormat = volume.format;
     if (sparse) volume.advise(io::LoadedVolume::Access::Sparse);
     extractSurface(volume.view, o.surface, x, clock, progress, 1, stages);
     if (volume.mapped) x.voxelBytesResident = volume.residentBytes();
   }
 
   progress.stage(stages - 1, stages, "writing " + o.output);
-  x.bytes = writeMeshFile(x.surface, o.output, x.binary);
+  if (precomputed) {
+    writePrecomputedOutput({{o.id, &x.surface, ""}}, o.output, o.format, x.surface.geometry, unit, o.precomputed);
+    x.bytes = directoryBytes(o.output);
+  } else {
+    x.bytes = writeMeshFile(x.surface, o.output, x.binary);
+  }
   clock.lap(x.timings, "write");
   x.totalSeconds = clock.total();
   progress.finish();

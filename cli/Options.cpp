@@ -355,6 +355,32 @@ void checkRaw(const InputOptions& in, const InputArgs& a) {
         "double)");
 }
 
+/// --lods, --sharded, --quantization-bits: the multi-resolution format's options.
+void addPrecomputedOptions(CLI::App& app, PrecomputedOptions& p) {
+  const std::string group = "Neuroglancer output";
+  app.add_option("--lods", p.lods, "precomputed-multires: levels of detail, 1 to 10 (default 3); each a\n"
+                 "closed oriented mesh of the label's genus, level k within 0.5 (2^k - 1)\nvoxels of level 0")
+      ->option_text("N")
+      ->check(CLI::Range(1, 10))
+      ->group(group);
+  app.add_flag("--sharded", p.sharded, "precomputed-multires: the sharded layout (a few .shard files)")->group(group);
+  app.add_option("--quantization-bits", p.quantizationBits, "precomputed-multires: 10 or 16 (default 16)")
+      ->option_text("B")
+      ->check(CLI::IsMember({10, 16}))
+      ->group(group);
+}
+
+/// The options of the precomputed formats agree with --format and -o.
+void checkPrecomputedOptions(const CLI::App& app, const std::string& format, const std::string& output) {
+  const bool multires = format == "precomputed-multires";
+  for (const char* name : {"--lods", "--sharded", "--quantization-bits"})
+    if (app.get_option(name)->count() > 0 && !multires)
+      throw UsageError(std::string(name) + " is for --format precomputed-multires");
+  if (!format.empty() && (output.find('{') != std::string::npos ||
+                          (output.back() != '/' && !std::filesystem::path(output).extension().empty())))
+    throw UsageError("--format " + format + " writes a directory: give -o DIR/, not '" + output + "'");
+}
+
 // --- parsing ---------------------------------------------------------------------------------
 
 std::string oneLine(std::string message) {
@@ -477,6 +503,21 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
       ->option_text("MIB")
       ->check(CLI::Range(1, 1 << 20))
       ->group("input and output");
+  app.add_option("--format", o.format, "precomputed or precomputed-multires: write -o DIR/ as a Neuroglancer\n"
+                 "mesh directory holding the surface as segment --id (docs/cli.md,\n\"Neuroglancer output\")")
+      ->option_text("F")
+      ->check(CLI::IsMember({"precomputed", "precomputed-multires"}))
+      ->group("Neuroglancer output");
+  app.add_option("--unit", o.unit, "the unit of the volume's spacing, for --format: nm, um, mm, cm, m\n"
+                 "(default: the unit the file states; mm for medical formats)")
+      ->option_text("U")
+      ->check(CLI::IsMember({"nm", "um", "µm", "mm", "cm", "m"}))
+      ->group("Neuroglancer output");
+  addValue(app, "--id", "N", [&o](const std::string& s) { o.id = *toLabel(s); },
+           "the segment id of the surface, for --format (default 1)")
+      ->check(kLabel)
+      ->group("Neuroglancer output");
+  addPrecomputedOptions(app, o.precomputed);
 
   addValue(
       app, "--iso", "S", [&o](const std::string& s) { o.surface.iso = toNumber(s); },
@@ -688,10 +729,13 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
       ->option_text("FILE")
       ->group("input and output");
   app.add_option("--format", o.format, "precomputed: write -o DIR/ as a Neuroglancer precomputed mesh\n"
-                 "directory (legacy format, nanometres; docs/cli.md, \"Neuroglancer output\")")
+                 "directory (legacy format, nanometres; docs/cli.md, \"Neuroglancer output\");\n"
+                 "precomputed-multires: Neuroglancer's multi-resolution format (Draco\n"
+                 "fragments, --lods levels of detail, --sharded)")
       ->option_text("F")
-      ->check(CLI::IsMember({"precomputed"}))
+      ->check(CLI::IsMember({"precomputed", "precomputed-multires"}))
       ->group("input and output");
+  addPrecomputedOptions(app, o.precomputed);
   app.add_option("--unit", o.unit, "the unit of the volume's spacing, for --format precomputed: nm, um,\n"
                  "mm, cm, m (default: the unit the file states; mm for NIfTI, NRRD,\n"
                  "MetaImage and DICOM, as ITK reads them)")
@@ -779,11 +823,17 @@ MeshOptions parseMeshOptions(const std::vector<std::string>& args) {
   if (o.surface.iso && o.surface.label) throw UsageError("give --iso or --label, not both");
   if (o.surface.label && o.surface.mapping == MappingMode::Linear)
     throw UsageError("--mapping linear interpolates an iso-value: it needs --iso, not --label");
+  if (o.format.empty() && (!o.unit.empty() || app.get_option("--id")->count() > 0))
+    throw UsageError("--unit and --id are for --format precomputed or precomputed-multires");
+  if (o.id.negative() || o.id == LabelValue(0))
+    throw UsageError("--id " + o.id.text() + ": Neuroglancer's segment ids are positive uint64 values");
+  checkPrecomputedOptions(app, o.format, o.output);
   parseDaskOptions(o.dask, a.block, o.workDir, o.block);
   if (!o.dask.empty() && (o.surface.seedMode != SeedMode::All || !o.surface.iso || o.surface.refine.smoothIterations > 0 ||
                           o.surface.refine.maxError || o.surface.refine.reduction))
     throw UsageError("--dask meshes every boundary of a threshold: give --all and --iso S (not --label, a seed "
                      "rule, Otsu's default, --smooth or decimation)");
+  if (!o.dask.empty() && !o.format.empty()) throw UsageError("--dask writes one mesh file: not with --format");
   checkRaw(o.input, a.input);
   return o;
 }
@@ -830,10 +880,8 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
     throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest, "
                      "--seed or --format yet");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
-  if (!o.unit.empty() && o.format != "precomputed") throw UsageError("--unit is for --format precomputed");
-  if (o.format == "precomputed" && (o.output.find('{') != std::string::npos ||
-                                    (o.output.back() != '/' && !std::filesystem::path(o.output).extension().empty())))
-    throw UsageError("--format precomputed writes a directory: give -o DIR/, not '" + o.output + "'");
+  if (!o.unit.empty() && o.format.empty()) throw UsageError("--unit is for --format precomputed or precomputed-multires");
+  checkPrecomputedOptions(app, o.format, o.output);
   checkRaw(o.input, a.input);
   return o;
 }

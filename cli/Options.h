@@ -71,12 +71,25 @@ struct OutputOptions {
   bool quiet = false;  ///< --quiet: nothing on stdout or stderr but errors
 };
 
+/// The multi-resolution precomputed format's options (labels and mesh).
+struct PrecomputedOptions {
+  int lods = 3;             ///< --lods N: levels of detail
+  bool sharded = false;     ///< --sharded
+  int quantizationBits = 16;  ///< --quantization-bits 10|16
+};
+
 struct MeshOptions {
   InputOptions input;
   SurfaceOptions surface;
   std::string output;   ///< -o: .ply, .obj, .off or .stl
   bool ascii = false;   ///< --ascii: text PLY / STL
   int cacheMiB = 512;   ///< --cache: decoded chunks kept when a chunked store is read lazily
+  /// --format precomputed | precomputed-multires: -o DIR/ is a Neuroglancer mesh directory
+  /// holding the surface as one segment, id --id (default 1).
+  std::string format;
+  std::string unit;        ///< --unit U (precomputed output)
+  LabelValue id = 1;       ///< --id N
+  PrecomputedOptions precomputed;
   /// --dask ADDRESS with --all: every boundary of a chunked store by blocks on Dask (as labels').
   std::string dask;
   std::array<int, 3> block{256, 256, 256};  ///< --block BX,BY,BZ (with --dask)
@@ -116,9 +129,10 @@ struct LabelsOptions {
   bool ascii = false;
   std::string table;  ///< --table FILE.csv | FILE.json
   /// --format precomputed: -o DIR/ is a Neuroglancer precomputed mesh directory (legacy format)
-  /// instead of one mesh file per label.
+  /// instead of one mesh file per label; precomputed-multires: the multi-resolution format.
   std::string format;
   std::string unit;   ///< --unit U: the physical unit of the volume's spacing (precomputed output)
+  PrecomputedOptions precomputed;
   /// --dask ADDRESS: a chunked store meshed by blocks on Dask (cli/DaskLabels.h): "local:N" or a
   /// scheduler's address ("tcp://host:8786"); empty: the single pass.
   std::string dask;

@@ -30,6 +30,13 @@ struct PrecomputedSegment {
 struct ToNanometres {
   std::array<std::array<double, 3>, 3> linear{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
   std::array<double, 3> offset{};
+
+  /// det(linear): negative for a map that mirrors (the triangles are then written reversed).
+  double determinant() const {
+    const auto& a = linear;
+    return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+           a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+  }
 };
 
 /// Writes `segments` as a legacy precomputed mesh directory at `directory`, whole or not at

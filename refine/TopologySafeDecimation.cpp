@@ -10,6 +10,7 @@
 #include "CheckedDecimater.h"
 #include "DistanceGuard.h"
 #include "EmbeddingGuard.h"
+#include "GridLockGuard.h"
 #include "TopologyGuard.h"
 
 namespace surftrack::refine {
@@ -52,6 +53,11 @@ DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p
     decimater.module(distance).set_tolerance(*p.maxError);
   }
   decimater.module(flipping).set_max_normal_deviation(p.maxNormalDeviation);
+  ModGridLockT<SurfaceMesh>::Handle lock;
+  if (p.grid) {
+    decimater.add(lock);
+    decimater.module(lock).set_grid(*p.grid, p.gridLevel);
+  }
   if (!decimater.initialize()) throw std::logic_error("decimateSafely: the decimater refused its modules");
   if (p.targetReduction)
     report.targetTriangles = std::size_t(std::llround((1 - *p.targetReduction) * double(report.trianglesBefore)));

@@ -5,7 +5,8 @@
 //  - keeps the mesh embedded (ModEmbeddingGuardT: no new triangle meets another one),
 //  - keeps the surface within `maxError` of the original one both ways, on samples
 //    (ModSampledDistanceT), and the quadric error below maxError^2 (ModQuadricT),
-//  - turns no triangle normal by more than `maxNormalDeviation` degrees (ModNormalFlippingT).
+//  - turns no triangle normal by more than `maxNormalDeviation` degrees (ModNormalFlippingT),
+//  - if a grid is given, keeps the mesh cut on its planes (ModGridLockT, for levels of detail).
 // A halfedge collapse moves no vertex: the survivors keep their points and their surfels.
 #pragma once
 
@@ -13,6 +14,7 @@
 #include <cstddef>
 #include <optional>
 
+#include "OctreeGrid.h"
 #include "SurfaceMesh.h"
 
 namespace surftrack::refine {
@@ -28,6 +30,10 @@ struct DecimationParameters {
   /// If set and raised, the decimation stops within a few thousand candidates and throws
   /// Cancelled (lib/Cancellation.h); the mesh is then partly decimated.
   const std::atomic<bool>* cancel = nullptr;
+  /// If set, the mesh is cut on the planes of this grid's level `gridLevel` and stays so
+  /// (GridLockGuard.h): the vertices on them stay, no triangle crosses or lies in one.
+  std::optional<OctreeGrid> grid;
+  int gridLevel = 0;
 };
 
 struct DecimationReport {

@@ -13,6 +13,8 @@ packages=(
   libgdcm-dev zlib1g-dev         # linked directly by io/ (DICOM series, gzip streams)
   libdeflate-dev pkg-config      # io/: a .nii.gz inflated in one call
   libblosc-dev libzstd-dev       # io/: the chunks of zarr and N5 stores (blosc, zstd)
+  libdraco-dev                   # Draco: the fragments of Neuroglancer's multi-resolution meshes (converter/DracoFragment.cpp)
+  draco                          # draco_decoder: decodes every fragment independently in python/tests/test_precomputed_multires.py
   libcli11-dev                   # CLI11: the command line
   nlohmann-json3-dev             # nlohmann-json: the CLI's JSON output
   libtbb-dev                     # oneTBB: the scanning method on every core
@@ -50,3 +52,12 @@ apt_install() {
 }
 apt_install -- "${packages[@]}"
 apt_install --no-install-recommends -- "${lean_packages[@]}"
+
+# draco3d from npm (Google's Emscripten build of Draco): a second decoder of the multi-resolution
+# fragments, independent of Debian's libdraco that writes them
+# (python/tests/test_precomputed_multires.py; skipped there when node or the package is missing).
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+if command -v npm >/dev/null && [[ ! -d "$root/python/tests/node/node_modules/draco3d" ]]; then
+  echo "setup: installing draco3d (npm) in python/tests/node" >&2
+  npm install --silent --no-audit --no-fund --prefix "$root/python/tests/node" >/dev/null
+fi

@@ -29,6 +29,7 @@
 #include "ChunkedStore.h"  // io/: zarr, OME-Zarr, N5
 #include "ReadVolume.h"    // io/: ReadError
 #include "PrecomputedMesh.h"  // converter/: Neuroglancer's format
+#include "MultiresolutionMeshes.h"  // refine/: its multi-resolution variant
 
 namespace py = pybind11;
 using namespace surftrack;
@@ -786,9 +787,10 @@ void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> 
 }
 
 /// Writes (label, vertices, faces, name) tuples as a Neuroglancer precomputed mesh directory
-/// (converter/PrecomputedMesh.h); `linear` and `offset` map the vertices to nanometres.
+/// (converter/PrecomputedMesh.h, or with lods > 0 the multi-resolution format of
+/// refine/MultiresolutionMeshes.h); `linear` and `offset` map the vertices to nanometres.
 void writePrecomputed(const py::list& segments, const std::string& path, std::array<std::array<double, 3>, 3> linear,
-                      std::array<double, 3> offset) {
+                      std::array<double, 3> offset, int lods, int quantizationBits, int sharding) {
   std::vector<std::vector<std::array<double, 3>>> vertices(segments.size());
   std::vector<std::vector<std::array<std::uint32_t, 3>>> triangles(segments.size());
   std::vector<PrecomputedSegment> out;
@@ -810,7 +812,18 @@ void writePrecomputed(const py::list& segments, const std::string& path, std::ar
     out.push_back({labelOf(t[0], "label"), &vertices[i], &triangles[i], t[3].cast<std::string>()});
   }
   try {
-    writePrecomputedMeshes(out, path, ToNanometres{linear, offset});
+    if (lods == 0) {
+      writePrecomputedMeshes(out, path, ToNanometres{linear, offset});
+    } else {
+      refine::MultiresolutionOptions o;
+      o.lods = lods;
+      o.quantizationBits = quantizationBits;
+      o.sharded = sharding != 0;  // 1: murmurhash3_x86_128, 2: identity
+      o.identityHash = sharding == 2;
+      std::atomic<bool> cancel{false};
+      o.cancel = &cancel;
+      runWatchingSignals(cancel, [&] { refine::writeMultiresolutionMeshes(out, path, ToNanometres{linear, offset}, o); });
+    }
   } catch (const std::invalid_argument& e) {
     throw py::value_error(e.what());
   }
