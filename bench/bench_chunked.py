@@ -208,7 +208,7 @@ def main():
         extra = ""
         if "chunks_decoded" in st:
             extra = (f", chunks decoded {st['chunks_decoded']} of {st['chunks']}, "
-                     f"{st['chunk_bytes_read'] / 2**20:.1f} MiB read")
+                     f"{st['bytes_read'] / 2**20:.1f} MiB read")
             if name.startswith("sparse"):  # (the chunk grid that "crossed" counts in)
                 extra += f" ({st['chunks_decoded'] / crossed:.2f} x those crossed)"
         stages = ", ".join(f"{k} {v:.3f}" for k, v in report["timings_s"].items())

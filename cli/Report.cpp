@@ -293,8 +293,8 @@ json extractionJson(const Extraction& x) {
     if (x.chunks) {
       storage["chunks"] = x.chunkCount;
       storage["chunks_decoded"] = x.chunks->chunksDecoded;
-      storage["chunk_bytes_read"] = x.chunks->bytesRead;
-      storage["chunk_cache_hits"] = x.chunks->hits;
+      storage["bytes_read"] = x.chunks->bytesRead;  // (from storage, compressed)
+      storage["cache_hits"] = x.chunks->hits;
     }
     j["input_storage"] = std::move(storage);
   }

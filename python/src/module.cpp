@@ -405,9 +405,9 @@ py::dict chunkFigures(const ChunkCache& cache) {
   const Dims n = cache.layout().chunkCounts();
   py::dict chunks;
   chunks["chunks"] = std::uint64_t(n.nx) * std::uint64_t(n.ny) * std::uint64_t(n.nz);
-  chunks["decoded"] = c.chunksDecoded;
+  chunks["chunks_decoded"] = c.chunksDecoded;
   chunks["bytes_read"] = c.bytesRead;
-  chunks["hits"] = c.hits;
+  chunks["cache_hits"] = c.hits;
   return chunks;
 }
 

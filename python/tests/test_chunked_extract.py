@@ -50,7 +50,7 @@ def test_a_seeded_extraction_from_a_store_is_the_arrays(tmp_path, dtype, chunks,
             whole = surftrack.extract(volume, seed=seed, **kwargs)
             assert np.array_equal(lazy.vertices, whole.vertices) and np.array_equal(lazy.faces, whole.faces)
             assert np.array_equal(lazy.surfels, whole.surfels) and lazy.components == whole.components
-            assert 0 < lazy.chunks["decoded"] <= lazy.chunks["chunks"]
+            assert 0 < lazy.chunks["chunks_decoded"] <= lazy.chunks["chunks"]
 
 
 def test_labels_and_ome_zarr_levels(tmp_path):
@@ -89,7 +89,7 @@ def test_far_chunks_are_never_read_and_full_reads_refused(tmp_path):
             (path / name).write_bytes(b"garbage")
     lazy = surftrack.extract(path, label=9, seed=(20, 24, 30))
     whole = surftrack.extract(volume, label=9, seed=(20, 24, 30))
-    assert np.array_equal(lazy.faces, whole.faces) and lazy.chunks["decoded"] < 64
+    assert np.array_equal(lazy.faces, whole.faces) and lazy.chunks["chunks_decoded"] < 64
     with pytest.raises(ValueError, match="reads every voxel"):
         surftrack.extract(path, label=9, mode="largest")
     with pytest.raises(ValueError, match="needs level= or label="):

@@ -74,10 +74,10 @@ def test_arrays_of_every_type_and_chunk_shape_give_the_arrays_surface(dtype):
         same(got, expected)
         # Every decode is a slice of the array: at most the chunks there are; a one-chunk cache
         # (every access evicts) decodes again and gives the same surface.
-        assert 0 < got.chunks["decoded"] <= got.chunks["chunks"]
+        assert 0 < got.chunks["chunks_decoded"] <= got.chunks["chunks"]
         small = surftrack.extract(array(), level=level, seed=centre, cache_mib=0)
         same(small, expected)
-        assert small.chunks["decoded"] >= got.chunks["decoded"]
+        assert small.chunks["chunks_decoded"] >= got.chunks["chunks_decoded"]
 
 
 def test_irregular_dask_chunks_labels_and_bools():
@@ -119,7 +119,7 @@ def test_far_boxes_are_never_sliced():
     rec = Recorder(volume, (8, 8, 8), centre=centre, far=6 + 8 + 8)
     got = surftrack.extract(rec, level=0.5, seed=centre)
     same(got, surftrack.extract(volume, level=0.5, seed=centre))
-    assert len(rec.boxes) == got.chunks["decoded"] < got.chunks["chunks"] // 10
+    assert len(rec.boxes) == got.chunks["chunks_decoded"] < got.chunks["chunks"] // 10
     assert len(set(rec.boxes)) == len(rec.boxes)  # each box sliced once (the cache holds them all)
 
 
