@@ -522,7 +522,8 @@ std::string dtypeName(ScalarType type) {
 /// (shape [z, y, x], dtype name) of a store's chosen array.
 py::tuple storeLayout(const std::string& path, int level, std::optional<std::int64_t> channel,
                       std::optional<std::int64_t> time) {
-  const ChunkLayout& l = openStore(path, level, channel, time).provider->layout();
+  const io::ChunkedStore store = openStore(path, level, channel, time);  // (alive while its layout is read)
+  const ChunkLayout& l = store.provider->layout();
   return py::make_tuple(py::make_tuple(l.dims.nz, l.dims.ny, l.dims.nx), dtypeName(l.type));
 }
 
