@@ -429,7 +429,6 @@ TEST(FrontDoor, TheNearestSurfelSearchStopsAtTheMaxSeedDistance) {
     o.seed = rule;
     o.maxSeedDistance = 256;  // the default
     const CountingSource counting(*view);
-    const auto started = std::chrono::steady_clock::now();
     try {
       extract(counting, o);
       ADD_FAILURE() << "no error for a seed 3992 voxels from the object";
@@ -441,7 +440,6 @@ TEST(FrontDoor, TheNearestSurfelSearchStopsAtTheMaxSeedDistance) {
     }
     // The bricks within 256 voxels of x = 4000 (and their aprons), not the 16.8 M voxels.
     EXPECT_LT(counting.read, d.count() / 4) << counting.read << " voxels read";
-    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(), 5.0);
 
     o.maxSeedDistance = std::numeric_limits<double>::infinity();
     const Surface unbounded = extract(*view, o);

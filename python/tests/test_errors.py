@@ -6,7 +6,6 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -129,10 +128,9 @@ def test_more_threads_than_cpus_run_quietly_on_the_cpus(capfd):
 
 def test_smooth_is_capped_as_in_the_cli():
     volume = ball((12, 12, 12), (6, 6, 6), 4)
-    start = time.monotonic()
+    # Refused before any work (10^9 iterations would run for hours: ctest's timeout would say so).
     with pytest.raises(ValueError, match="smooth takes at most 100000 iterations"):
         surftrack.extract(volume, label=100, mode="largest", smooth=10 ** 9)
-    assert time.monotonic() - start < 1.0
     assert surftrack.extract(volume, label=100, mode="largest", smooth=2).refine["smooth_iterations"] == 2
 
 
@@ -144,12 +142,11 @@ def test_smooth_is_capped_as_in_the_cli():
     lambda v: surftrack.label_surfaces(np.broadcast_to(np.uint8(1), v.shape)),
 ])
 def test_a_vast_broadcast_volume_is_refused_at_once(call):
-    # 2^60 voxels of one value: any scan of them would run for years.
+    # 2^60 voxels of one value: any scan of them would run for years, so a refusal that comes
+    # back at all came before the scan (ctest's timeout catches one that does not).
     vast = np.broadcast_to(np.float32(1), (2 ** 20,) * 3)
-    start = time.monotonic()
     with pytest.raises(ValueError, match="each dimension must be at most 524285"):
         call(vast)
-    assert time.monotonic() - start < 0.5
 
 
 def test_the_largest_dimension_is_taken():

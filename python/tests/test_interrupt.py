@@ -53,12 +53,9 @@ def test_sigint_stops_a_long_refinement(stage, n):
         time.sleep(1.0)
         assert child.poll() is None, "the stage ended within a second: the test would prove nothing"
         child.send_signal(signal.SIGINT)
-        start = time.monotonic()
-        out, err = child.communicate(timeout=PATIENCE)
-        elapsed = time.monotonic() - start
+        out, err = child.communicate(timeout=PATIENCE)  # (a stop that never comes fails below)
     except subprocess.TimeoutExpired:
         child.kill()
         child.communicate()
         pytest.fail(f"{stage}: still running {PATIENCE} s after SIGINT")
     assert child.returncode == 3 and out.strip() == "KeyboardInterrupt", (child.returncode, out, err)
-    assert elapsed < PATIENCE
