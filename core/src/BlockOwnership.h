@@ -4,6 +4,8 @@
 // owning cube of a triangle, by which the merges restore the single pass's order of triangles.
 #pragma once
 
+#include "ScanLabels.h"
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -51,6 +53,19 @@ inline void requireBlock(const VolumeView& view, Voxel origin, Dims volume, Voxe
 /// Keeps the keys some triangle uses, still increasing, and renumbers the triangles: a block's
 /// scan numbers every surfel of the planes it reads, but an owned cube's triangles use only
 /// surfels of the volume with both voxels in the box or one outside the volume.
+/// The cubes a block owns (docs/theory.md, "Label maps by blocks"), in the coordinates of its box
+/// from `origin`: min corners in [lo, hi), and -1 where the core starts at the volume's low face
+/// (the box then does too), for the cubes over that face.
+inline ScanOwnership ownedCubes(Voxel origin, Voxel lo, Voxel hi) {
+  ScanOwnership own;
+  own.origin = origin;
+  for (int a = 0; a < 3; ++a) {
+    own.lo[std::size_t(a)] = lo[a] == 0 ? -1 : lo[a] - origin[a];
+    own.hi[std::size_t(a)] = hi[a] - origin[a];
+  }
+  return own;
+}
+
 inline void dropUnusedKeys(std::vector<std::uint64_t>& keys, std::vector<std::array<std::uint32_t, 3>>& triangles) {
   std::vector<std::uint32_t> index(keys.size(), 0);
   for (const auto& t : triangles)

@@ -37,14 +37,7 @@ std::vector<LabelFragment> scanBlockTyped(const VolumeView& view, Voxel origin, 
   if (o.labels.kind == LabelSelection::Kind::Range) requireNonEmptyRange(o.labels);
   const VolumeRef<T> image(static_cast<const T*>(view.data), view.dims, view.strides[0], view.strides[1],
                            view.strides[2]);
-  // The owned cubes in the box's coordinates; -1 where the core starts at the volume's low face
-  // (then the box does too), the cubes over that face.
-  ScanOwnership own;
-  own.origin = origin;
-  for (int a = 0; a < 3; ++a) {
-    own.lo[std::size_t(a)] = lo[a] == 0 ? -1 : lo[a] - origin[a];
-    own.hi[std::size_t(a)] = hi[a] - origin[a];
-  }
+  const ScanOwnership own = ownedCubes(origin, lo, hi);
   tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
   const int parts = o.threads == 1 ? 1 : std::min(hi.z - lo.z, 4 * std::max(1, arena.max_concurrency()));
   const WantedLabel<T> wanted(o.labels);

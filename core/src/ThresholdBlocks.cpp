@@ -92,12 +92,7 @@ ThresholdFragment scanThresholdBlock(const VolumeView& view, Voxel origin, Dims 
       }
     }
   const VolumeRef<std::uint8_t> image(binary.data(), dims, 1, dims.nx, std::ptrdiff_t(dims.nx) * dims.ny);
-  ScanOwnership own;  // the owned cubes in the box's coordinates (scanLabelBlock's)
-  own.origin = origin;
-  for (int a = 0; a < 3; ++a) {
-    own.lo[std::size_t(a)] = lo[a] == 0 ? -1 : lo[a] - origin[a];
-    own.hi[std::size_t(a)] = hi[a] - origin[a];
-  }
+  const ScanOwnership own = ownedCubes(origin, lo, hi);
   tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
   const int parts = o.threads == 1 ? 1 : std::min(hi.z - lo.z, 4 * std::max(1, arena.max_concurrency()));
   const TheOneVoxels wanted;
