@@ -14,6 +14,11 @@ as numpy is — and writes one fragment file; a block whose file exists is not c
 a stopped run resumes), one plan task, one task per shard of labels (reads its labels' fragments
 from the files, merges, writes or returns). Fragments go through the file system, never through
 the scheduler: ``work_dir`` must be shared by every worker.
+
+In Neuroglancer's formats (docs/python.md, "Neuroglancer output on Dask"), the reduce tasks
+encode each label with the single pass' C++ encoders (write_precomputed's), then, sharded, one
+task per Neuroglancer shard assembles its file, and a final task writes ``info`` and moves the
+staging directory into place.
 """
 from __future__ import annotations
 

@@ -95,7 +95,7 @@ def test_blocks_write_the_single_pass_directory(client, tmp_path, case):
 def test_many_shards(client, tmp_path):
     """More segments than one shard holds (shardingFor: 2^14 keys a shard before shards
     multiply): one task per shard, each file the single pass' own."""
-    shape = (26, 26, 26)
+    shape = (34, 34, 34)
     count = 2**14 + 300
     labels = np.zeros(shape, np.uint32)
     cells = np.argwhere(np.indices(shape).sum(0) % 2 == 0)[:count]  # single voxels, none touching by a face
@@ -105,7 +105,7 @@ def test_many_shards(client, tmp_path):
     for sharded in ["identity", True]:
         want, got = tmp_path / f"single-{sharded}", tmp_path / f"dask-{sharded}"
         surftrack.write_precomputed(surfaces, want, axes="zyx", spacing=(1, 1, 1), lods=1, sharded=sharded)
-        blocks.write_label_meshes(labels, got, block=(13, 26, 9), client=client, format="precomputed-multires",
+        blocks.write_label_meshes(labels, got, block=(17, 34, 12), client=client, format="precomputed-multires",
                                   axes="zyx", lods=1, sharded=sharded)
         files = tree(want)
         assert tree(got) == files and sum(f.endswith(".shard") for f in files) > 1
