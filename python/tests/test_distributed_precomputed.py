@@ -19,6 +19,7 @@ if "asan" in os.environ.get("LD_PRELOAD", ""):
 distributed = pytest.importorskip("dask.distributed")
 
 from surftrack import distributed as blocks  # noqa: E402
+from test_distributed import run_cli  # noqa: E402  (the CLI built beside the package)
 
 
 @pytest.fixture(scope="module")
@@ -63,12 +64,12 @@ FORMATS = [  # (format, write_label_meshes' options)
 def test_blocks_write_the_single_pass_directory(client, tmp_path, case):
     fmt, options = FORMATS[case]
     rng = np.random.default_rng(100 + case)
-    for run, dtype in enumerate([np.uint8, np.uint16, np.uint32, np.uint64]):
+    for run, dtype in enumerate([np.uint8, np.uint16, np.uint32, np.uint64] * 2):
         shape = tuple(int(n) for n in rng.integers(8, 13, size=3))
         labels = random_labels(rng, shape, dtype)
-        block = [(4, 5, 3), (1, 7, 20), (6, 6, 6), (20, 20, 20)][run]
+        block = [(4, 5, 3), (1, 7, 20), (6, 6, 6), (20, 20, 20), (3, 3, 3), (5, 12, 2), (7, 1, 9), (9, 4, 11)][run]
         spacing = tuple(float(v) for v in rng.choice([0.5, 1.0, 4.0], size=3))
-        axes, unit = ["zyx", "xyz"][run % 2], ["nm", "um"][run // 2]
+        axes, unit = ["zyx", "xyz"][run % 2], ["nm", "um", "mm"][run % 3]
         present = [int(L) for L in np.unique(labels) if L]
         names = {L: f"cell {i}" for i, L in enumerate(present) if i % 2} if run % 2 else None
         surfaces = surftrack.label_surfaces(labels, spacing=spacing, origin=(1, -2, 3))
@@ -143,18 +144,6 @@ def test_bad_input_writes_nothing(client, tmp_path):
     with pytest.raises(ValueError, match="not an empty directory"):
         blocks.write_label_meshes(labels, tmp_path / "full", client=client, format="precomputed", axes="zyx")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["full", "work"]
-
-
-def cli():
-    path = os.environ.get("SURFTRACK_CLI") or str(Path(__file__).resolve().parents[2] / "build" / "cli" / "surftrack")
-    if not os.access(path, os.X_OK):
-        pytest.skip(f"the surftrack CLI is not built at {path}")
-    return path
-
-
-def run_cli(*args):
-    import subprocess
-    return subprocess.run([cli(), *map(str, args)], capture_output=True, text=True, timeout=300)
 
 
 def test_cli_labels_on_dask_writes_the_single_pass_directory(tmp_path):
