@@ -160,7 +160,7 @@ def _file_name(label, naming):
 def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None, encoding=None):
     """Task: every label of a shard merged; written into `out_dir` (named by _file_name) when it
     is given (the files only, returned as figures), else the surfaces' fields returned. With
-    `encoding` (_Encoding), each label encoded in Neuroglancer's format instead (_encode)."""
+    `encoding` (_Encoding), each label encoded in Neuroglancer's format instead (_EncodedLabels)."""
     from . import Surface
     out = {}
     fragments = _shard_fragments(shard)

@@ -139,6 +139,16 @@ def test_bad_input_writes_nothing(client, tmp_path):
     with pytest.raises(ValueError, match="segment id -3"):
         blocks.write_label_meshes(labels, tmp_path / "out", block=(3, 3, 3), client=client, format="precomputed",
                                   axes="zyx", work_dir=tmp_path / "work")
+    # A reduce task fails after others wrote their labels' files (vertices beyond float32
+    # nanometres far from the origin only): the staging directory goes, nothing is left.
+    far = np.zeros((12, 6, 6), np.uint16)
+    far[0:2, 0:2, 0:2], far[9:11, 3:5, 3:5] = 1, 2
+    with pytest.raises(ValueError, match="beyond a float32"):
+        surftrack.write_precomputed(surftrack.label_surfaces(far, spacing=(1e29, 1, 1)), tmp_path / "single",
+                                    axes="zyx", unit="m", spacing=(1e29, 1, 1))
+    with pytest.raises(ValueError, match="beyond a float32"):
+        blocks.write_label_meshes(far, tmp_path / "out", block=(6, 6, 6), spacing=(1e29, 1, 1), client=client,
+                                  shards=2, format="precomputed", axes="zyx", unit="m", work_dir=tmp_path / "work")
     (tmp_path / "full").mkdir()
     (tmp_path / "full" / "x").write_text("x")
     with pytest.raises(ValueError, match="not an empty directory"):
