@@ -158,7 +158,8 @@ def test_bad_input_writes_nothing(client, tmp_path):
 
 def test_cli_labels_on_dask_writes_the_single_pass_directory(tmp_path):
     """`surftrack labels STORE -o DIR/ --dask local:2 --format ...` against the CLI's single
-    pass on the same OME-Zarr store (micrometres, anisotropic, label names): every file."""
+    pass on the same OME-Zarr store (micrometres or --unit nm, anisotropic, label names, a frame
+    and an origin given): every file, and the table."""
     zarr = pytest.importorskip("zarr")
     rng = np.random.default_rng(41)
     shape = (21, 17, 23)
@@ -175,7 +176,8 @@ def test_cli_labels_on_dask_writes_the_single_pass_directory(tmp_path):
                                       {"type": "scale", "scale": [2.0, 1.5, 1.0]}]}]}]
     names = tmp_path / "names.txt"
     names.write_text(f"{2**64 - 19} first\n{2**64 - 15} second one\n")
-    for fmt in [["precomputed"], ["precomputed-multires", "--lods", "2", "--sharded"]]:
+    for fmt in [["precomputed", "--unit", "nm"],
+                ["precomputed-multires", "--lods", "2", "--sharded", "--frame", "ras", "--origin", "5,-3,2"]]:
         single, dask = tmp_path / f"single-{fmt[0]}", tmp_path / f"dask-{fmt[0]}"
         common = ["--label-names", names, "--format", *fmt]
         a = run_cli("labels", store, "-o", f"{single}/", *common, "--table", tmp_path / "a.csv")
