@@ -19,6 +19,7 @@
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -42,44 +43,70 @@ void inBlocks(tbb::task_arena& arena, std::size_t n, Body&& body) {
 
 /// Unit outward vertex normals as float32: the bits of vertexNormals() (core/src/Figures.cpp)
 /// converted, computed in parallel. That function adds the triangles' normals into their
-/// vertices' sums in triangle order (refine::sumTriangleNormals); here each vertex sums its own
-/// triangles, found through a vertex -> triangles index sorted by triangle, in that same order
-/// from the same zero: the same additions, so the same doubles, whoever computes them.
+/// vertices' sums in triangle order (refine::sumTriangleNormals); so does this, from the same
+/// zero — the same additions, so the same doubles, for any number of threads. The triangles are
+/// cut into consecutive chunks, one thread each; a vertex that only one chunk's range of vertex
+/// indices covers is summed by that chunk alone, in order; the few others (where the ranges of
+/// two chunks overlap: the scan numbers vertices and triangles slab by slab, so those of a
+/// chunk are near each other) are summed afterwards, chunk after chunk, on one thread.
 void vertexNormalsInto(const Surface& s, float* out, tbb::task_arena& arena) {
   const std::size_t n = s.vertices.size(), m = s.triangles.size();
   const auto& points = s.vertices;
   const auto& triangles = s.triangles;
-  // end[v]: first the number of triangles at v - 1 (end[0] stays 0), then, after the prefix
-  // sum, where v's triangles begin; filling moves it to where they end, v + 1's beginning.
-  FreshArray<std::uint64_t> end = freshArray<std::uint64_t>(n + 1);
-  inBlocks(arena, n + 1, [&](std::size_t b, std::size_t e) { std::fill(end.get() + b, end.get() + e, 0); });
-  inBlocks(arena, m, [&](std::size_t b, std::size_t e) {
-    for (std::size_t f = b; f < e; ++f)
-      for (std::uint32_t v : triangles[f]) std::atomic_ref<std::uint64_t>(end[v + 1]).fetch_add(1, std::memory_order_relaxed);
+  auto normalOf = [&](const std::array<std::uint32_t, 3>& t) {
+    return refine::triangleNormal({points[t[0]], points[t[1]], points[t[2]]});
+  };
+  const std::size_t chunkCount =
+      std::clamp<std::size_t>(m / (std::size_t(1) << 12), 1, 4 * std::size_t(arena.max_concurrency()));
+  auto chunkBegin = [&](std::size_t k) { return m * k / chunkCount; };
+  // Each chunk's range of vertex indices; covers[v]: how many ranges hold v.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> range(chunkCount, {~0u, 0u});
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), chunkCount, [&](std::size_t k) {
+      auto& [low, high] = range[k];
+      for (std::size_t f = chunkBegin(k); f < chunkBegin(k + 1); ++f)
+        for (std::uint32_t v : triangles[f]) low = std::min(low, v), high = std::max(high, v);
+    });
   });
-  for (std::size_t v = 1; v <= n; ++v) end[v] += end[v - 1];
-  FreshArray<std::uint32_t> around = freshArray<std::uint32_t>(3 * m);
-  inBlocks(arena, m, [&](std::size_t b, std::size_t e) {
-    for (std::size_t f = b; f < e; ++f)
+  std::vector<int> steps(n + 1, 0);
+  for (const auto& [low, high] : range)
+    if (low <= high) ++steps[low], --steps[std::size_t(high) + 1];
+  FreshArray<std::uint8_t> shared = freshArray<std::uint8_t>(n);  // covered by two ranges or more
+  for (std::size_t v = 0, covering = 0; v < n; ++v) shared[v] = (covering += steps[v]) > 1;
+  steps = {};
+  FreshArray<refine::Point3> sums = freshArray<refine::Point3>(n);
+  inBlocks(arena, n, [&](std::size_t b, std::size_t e) { std::fill(sums.get() + b, sums.get() + e, refine::Point3{0, 0, 0}); });
+  std::vector<std::vector<std::uint32_t>> later(chunkCount);  // triangles with a shared vertex
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), chunkCount, [&](std::size_t k) {
+      for (std::size_t f = chunkBegin(k); f < chunkBegin(k + 1); ++f) {
+        const refine::Point3 normal = normalOf(triangles[f]);
+        bool defer = false;
+        for (std::uint32_t v : triangles[f]) {
+          if (shared[v]) {
+            defer = true;
+            continue;
+          }
+          for (int i = 0; i < 3; ++i) sums[v][i] += normal[i];
+        }
+        if (defer) later[k].push_back(std::uint32_t(f));
+      }
+    });
+  });
+  for (const std::vector<std::uint32_t>& chunk : later)
+    for (std::uint32_t f : chunk) {
+      const refine::Point3 normal = normalOf(triangles[f]);
       for (std::uint32_t v : triangles[f])
-        around[std::atomic_ref<std::uint64_t>(end[v]).fetch_add(1, std::memory_order_relaxed)] = std::uint32_t(f);
-  });
+        if (shared[v])
+          for (int i = 0; i < 3; ++i) sums[v][i] += normal[i];
+    }
   inBlocks(arena, n, [&](std::size_t b, std::size_t e) {
     for (std::size_t v = b; v < e; ++v) {
-      std::uint32_t* first = around.get() + (v == 0 ? 0 : end[v - 1]);
-      std::uint32_t* last = around.get() + end[v];
-      for (std::uint32_t* i = first + 1; i < last; ++i)  // insertion sort: a handful each
-        for (std::uint32_t* j = i; j > first && j[-1] > j[0]; --j) std::swap(j[-1], j[0]);
-      refine::Point3 sum{0, 0, 0};
-      for (const std::uint32_t* i = first; i < last; ++i) {
-        const auto& t = triangles[*i];
-        const refine::Point3 normal = refine::triangleNormal({points[t[0]], points[t[1]], points[t[2]]});
-        for (int k = 0; k < 3; ++k) sum[k] += normal[k];
-      }
+      refine::Point3 sum = sums[v];
       const double length = std::sqrt(refine::dot(sum, sum));
       if (length > 0)
         for (double& x : sum) x /= length;
-      for (int k = 0; k < 3; ++k) out[3 * v + k] = float(sum[k]);
+      for (int i = 0; i < 3; ++i) out[3 * v + i] = float(sum[i]);
     }
   });
 }
@@ -144,7 +171,7 @@ Arrays meshArrays(const VolumeView& view, double level, AdjacencyPair pair, bool
     });
   });
   a.normals = freshArray<float>(3 * n);
-  if (arena.max_concurrency() == 1 || m > std::numeric_limits<std::uint32_t>::max()) {  // the core's own sum
+  if (m > std::numeric_limits<std::uint32_t>::max()) {  // (beyond the chunks' uint32 indices) the core's own
     const std::vector<std::array<double, 3>> normals = vertexNormals(s);
     for (std::size_t v = 0; v < n; ++v)
       for (int k = 0; k < 3; ++k) a.normals[3 * v + k] = float(normals[v][k]);
