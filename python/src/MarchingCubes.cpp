@@ -72,7 +72,8 @@ void vertexNormalsInto(const Surface& s, float* out, tbb::task_arena& arena) {
   for (const auto& [low, high] : range)
     if (low <= high) ++steps[low], --steps[std::size_t(high) + 1];
   FreshArray<std::uint8_t> shared = freshArray<std::uint8_t>(n);  // covered by two ranges or more
-  for (std::size_t v = 0, covering = 0; v < n; ++v) shared[v] = (covering += steps[v]) > 1;
+  int covering = 0;
+  for (std::size_t v = 0; v < n; ++v) shared[v] = (covering += steps[v]) > 1;
   steps = {};
   FreshArray<refine::Point3> sums = freshArray<refine::Point3>(n);
   inBlocks(arena, n, [&](std::size_t b, std::size_t e) { std::fill(sums.get() + b, sums.get() + e, refine::Point3{0, 0, 0}); });
@@ -171,7 +172,7 @@ Arrays meshArrays(const VolumeView& view, double level, AdjacencyPair pair, bool
     });
   });
   a.normals = freshArray<float>(3 * n);
-  if (m > std::numeric_limits<std::uint32_t>::max()) {  // (beyond the chunks' uint32 indices) the core's own
+  if (m > std::numeric_limits<std::uint32_t>::max()) {  // beyond the chunks' uint32 indices: the core's sum
     const std::vector<std::array<double, 3>> normals = vertexNormals(s);
     for (std::size_t v = 0; v < n; ++v)
       for (int k = 0; k < 3; ++k) a.normals[3 * v + k] = float(normals[v][k]);
