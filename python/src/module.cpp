@@ -12,9 +12,6 @@
 
 #include <atomic>
 #include <cstring>
-#include <chrono>
-#include <future>
-#include <regex>
 #include <system_error>
 
 #include <surftrack/Extract.h>
@@ -26,6 +23,8 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include "ArrayChunkProvider.h"
+#include "EngineCalls.h"  // arrays as views, Ctrl-C, errors in array axes
+#include "MarchingCubes.h"
 #include "ChunkedStore.h"  // io/: zarr, OME-Zarr, N5
 #include "ReadVolume.h"    // io/: ReadError
 #include "PrecomputedMesh.h"  // converter/: Neuroglancer's format
@@ -35,6 +34,7 @@
 
 namespace py = pybind11;
 using namespace surftrack;
+using namespace surftrack::binding;
 
 namespace {
 
@@ -74,123 +74,6 @@ py::int_ labelObject(const LabelValue& L) {
   return py::reinterpret_steal<py::int_>(PyLong_FromUnsignedLongLong(L.magnitude()));
 }
 
-/// The ScalarType of a numpy dtype; throws TypeError for anything but the ten types.
-ScalarType scalarTypeOfDtype(const py::dtype& dtype) {
-  const char kind = dtype.kind();
-  const auto size = dtype.itemsize();
-  if (kind == 'u' || kind == 'b') {
-    if (size == 1) return ScalarType::UInt8;
-    if (size == 2) return ScalarType::UInt16;
-    if (size == 4) return ScalarType::UInt32;
-    if (size == 8) return ScalarType::UInt64;
-  } else if (kind == 'i') {
-    if (size == 1) return ScalarType::Int8;
-    if (size == 2) return ScalarType::Int16;
-    if (size == 4) return ScalarType::Int32;
-    if (size == 8) return ScalarType::Int64;
-  } else if (kind == 'f') {
-    if (size == 4) return ScalarType::Float32;
-    if (size == 8) return ScalarType::Float64;
-  }
-  throw py::type_error("unsupported volume dtype '" + py::cast<std::string>(py::str(py::handle(dtype))) +
-                       "': expected bool, uint8/16/32/64, int8/16/32/64, float32 or float64");
-}
-
-/// The largest volume dimension the engine takes (core/src/ViewSource.cpp: surfel keys hold 20
-/// bits per coordinate, with a voxel of margin on each side).
-constexpr int kMaxDimension = Surfel::kCoordinateLimit - 3;
-
-/// Runs `work` (engine code that touches no Python object without taking the GIL) on a worker
-/// thread while the calling thread watches for Ctrl-C: Python runs its signal handlers on the
-/// main thread only, between bytecodes, and the engine's long loops (tracking, scanning,
-/// smoothing, decimation, writing) check `cancel` instead. Every 50 ms the caller takes the GIL
-/// and runs the pending handlers (PyErr_CheckSignals); one that raises (KeyboardInterrupt for
-/// SIGINT) raises `cancel`, and once the work has stopped at its next check that exception is
-/// raised here. Otherwise the work's own exception, if any, is rethrown here.
-template <class Work>
-void runWatchingSignals(std::atomic<bool>& cancel, Work&& work) {
-  std::future<void> done = std::async(std::launch::async, std::forward<Work>(work));
-  for (;;) {
-    bool finished;
-    {
-      py::gil_scoped_release release;
-      finished = done.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready;
-    }
-    if (finished) break;
-    if (PyErr_CheckSignals() != 0) {
-      py::error_already_set interrupt;  // the handler's exception, fetched
-      cancel = true;
-      {
-        py::gil_scoped_release release;
-        done.wait();
-      }
-      try {
-        done.get();
-      } catch (...) {  // Cancelled, or whatever came first: the interrupt is what the caller asked
-      }
-      throw interrupt;
-    }
-  }
-  done.get();
-}
-
-/// Applies `format` to every match of `re` in `text`.
-template <class Format>
-std::string replaceMatches(const std::string& text, const std::regex& re, Format&& format) {
-  std::string out;
-  auto last = text.cbegin();
-  for (std::sregex_iterator it(text.begin(), text.end(), re), end; it != end; ++it) {
-    out.append(last, (*it)[0].first);
-    out += format(*it);
-    last = (*it)[0].second;
-  }
-  out.append(last, text.cend());
-  return out;
-}
-
-/// An engine message with its voxel coordinates in the caller's axes: the engine's x, y, z are
-/// the array axes order[0..2] (surftrack/__init__.py), and its messages print a voxel as
-/// "(x,y,z)" after "voxel ", "voxel index " or, in a surfel, "c=" and "d=", and a domain as
-/// "[0,nx)x[0,ny)x[0,nz)" (core/src/Extract.cpp, core/src/Labels.cpp). Physical points are in
-/// the caller's frame already and are left alone.
-std::string inArrayAxes(const std::string& message, std::array<int, 3> order) {
-  static const std::regex voxel(R"re((voxel |voxel index |c=|d=)\(([^,()]+),([^,()]+),([^,()]+)\))re");
-  static const std::regex domain(R"re(\[0,(\d+)\)x\[0,(\d+)\)x\[0,(\d+)\))re");
-  auto permuted = [&](const std::smatch& m, int first) {
-    std::array<std::string, 3> a;
-    for (int e = 0; e < 3; ++e) a[std::size_t(order[e])] = m[first + e].str();
-    return a;
-  };
-  const std::string voxels = replaceMatches(message, voxel, [&](const std::smatch& m) {
-    const auto a = permuted(m, 2);
-    return m[1].str() + "(" + a[0] + "," + a[1] + "," + a[2] + ")";
-  });
-  return replaceMatches(voxels, domain, [&](const std::smatch& m) {
-    const auto a = permuted(m, 1);
-    return "[0," + a[0] + ")x[0," + a[1] + ")x[0," + a[2] + ")";
-  });
-}
-
-/// runWatchingSignals for the engine's extractions: their errors' voxels in the caller's axes.
-template <class Work>
-void runEngine(std::array<int, 3> order, std::atomic<bool>& cancel, Work&& work) {
-  try {
-    runWatchingSignals(cancel, std::forward<Work>(work));
-  } catch (const InvalidInput& e) {
-    throw InvalidInput(inArrayAxes(e.what(), order));
-  } catch (const InternalError& e) {
-    throw InternalError(inArrayAxes(e.what(), order));
-  }
-}
-
-/// A numpy array over `data` (shape `shape`), owned by the heap object `owner`: no copy.
-template <class T, class Owner>
-py::array_t<T> viewOf(T* data, std::vector<py::ssize_t> shape, std::shared_ptr<Owner> owner) {
-  auto* keep = new std::shared_ptr<Owner>(std::move(owner));
-  py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<Owner>*>(p); });
-  return py::array_t<T>(shape, data, base);
-}
-
 /// An extracted surface held for Python: its vectors are the numpy arrays (no copy); normals
 /// and surfels in array axes are computed on first use, without the GIL.
 struct Result {
@@ -222,32 +105,6 @@ struct Result {
     return viewOf(out->data(), {py::ssize_t(r->surface.surfels.size()), 2, 3}, out);
   }
 };
-
-/// The view of `volume` whose engine axes x, y, z are the array axes order[0..2], with its
-/// geometry given in array axes.
-VolumeView viewOfArray(const py::array& volume, std::array<int, 3> order, std::array<double, 3> spacing,
-                       std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction) {
-  if (volume.ndim() != 3)
-    throw py::value_error("the volume must be 3-D, not " + std::to_string(volume.ndim()) + "-D");
-  const ScalarType type = scalarTypeOfDtype(volume.dtype());
-  VolumeView view;
-  view.data = volume.data();
-  view.type = type;
-  for (int e = 0; e < 3; ++e) {
-    const int a = order[e];
-    if (volume.shape(a) == 0) throw py::value_error("the volume is empty (a dimension is 0)");
-    if (volume.shape(a) > kMaxDimension)
-      throw py::value_error("a volume dimension exceeds " + std::to_string(kMaxDimension));
-    if (volume.strides(a) % py::ssize_t(sizeOf(type)) != 0)
-      throw py::value_error("the volume's strides are not multiples of its item size");
-    (e == 0 ? view.dims.nx : e == 1 ? view.dims.ny : view.dims.nz) = int(volume.shape(a));
-    view.strides[e] = volume.strides(a) / py::ssize_t(sizeOf(type));
-    view.geometry.spacing[e] = spacing[a];
-    for (int k = 0; k < 3; ++k) view.geometry.direction[k][e] = direction[k][a];
-  }
-  view.geometry.origin = origin;
-  return view;
-}
 
 /// The arrays and figures of an extracted surface, as the keyword arguments of Python's Surface.
 py::dict surfaceDict(const std::shared_ptr<Result>& r) {
@@ -982,6 +839,7 @@ PYBIND11_MODULE(_surftrack, m) {
       .def("normals", &Result::normals)
       .def("surfels", &Result::surfels);
   m.def("extract_array", &extractArray);
+  defineMarchingCubes(m);
   m.def("extract_store", &extractStore);
   m.def("extract_chunked", &extractChunked);
   m.def("store_layout", &storeLayout);
