@@ -29,6 +29,7 @@
 #include "HugePages.h"
 
 #include <boost/pending/disjoint_sets.hpp>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -77,6 +78,15 @@ struct PlaneEdges {
   std::vector<std::uint32_t> y;  // edge (x, y, z)-(x, y + 1, z)
 };
 
+/// The edge-index arrays of a run of slabs: its two planes and two rows of z-edges. One set per
+/// thread, kept for every run the thread takes (a run numbers every cut edge before reading it,
+/// so what an earlier run left is never read): a run would otherwise allocate and zero its own,
+/// 16 (ny + 2)(nx + 2) bytes, once for each of the 8 runs per thread.
+struct EdgePlanes {
+  PlaneEdges bottom, top;
+  std::vector<std::uint32_t> zEdge;
+};
+
 /// The scan of one binary image. Count, prefix sum, fill (as OpenVDB's VolumeToMesh does): the
 /// image is binarised plane by plane, the vertices and triangles of every slab z..z+1 are
 /// counted, and then runs of slabs are filled in parallel, each writing its vertices and
@@ -114,8 +124,10 @@ class Scanner {
       if (x < dims.nx) cubeMask_[b >> 6] |= bit(b);
     }
     // The whole binary image, planes z = -1 .. nz, read once (RowSource::fillRow may be called
-    // from several threads at once).
-    bits_.assign(std::size_t(dims.nz + 2) * rowCount_ * words_, 0);
+    // from several threads at once). It and the mesh are fresh memory on every call (the
+    // allocator hands a freed heap's pages back to the system): huge pages make their first
+    // writes a fifth as dear (lib/HugePages.h; docs/performance.md, 'Fresh memory on this machine').
+    bits_ = hugePageVector<std::uint64_t>(std::size_t(dims.nz + 2) * rowCount_ * words_);
     forEach(-1, dims.nz + 1, [&](int z) {
       for (int j = 0; j < rowCount_; ++j) rows.fillRow(j - 1, z, mutableRow(z, j));
     });
@@ -222,6 +234,19 @@ class Scanner {
   }
 
  private:
+  /// This thread's edge-index arrays (EdgePlanes), allocated on its first run.
+  EdgePlanes& threadPlanes() const {
+    EdgePlanes& p = planes_.local();
+    if (p.zEdge.empty()) {
+      for (PlaneEdges* e : {&p.bottom, &p.top}) {
+        e->x.assign(std::size_t(rowCount_) * columns_, 0);
+        e->y.assign(std::size_t(rowCount_) * columns_, 0);
+      }
+      p.zEdge.assign(2 * columns_, 0);
+    }
+    return p;
+  }
+
   /// f(i) for i in [begin, end): on the arena's threads, or in order on this one.
   template <class F>
   void forEach(int begin, int end, F&& f) {
@@ -427,13 +452,9 @@ class Scanner {
   /// One thread's run of slabs: its edge-index planes and its cursor into the vertices.
   template <class Output>
   struct Run {
-    Run(const Scanner& scanner, Output& output) : s(scanner), out(output) {
-      for (PlaneEdges* p : {&bottom, &top}) {
-        p->x.assign(std::size_t(s.rowCount_) * s.columns_, 0);
-        p->y.assign(std::size_t(s.rowCount_) * s.columns_, 0);
-      }
-      zEdge.assign(2 * s.columns_, 0);
-    }
+    Run(const Scanner& scanner, Output& output)
+        : s(scanner), out(output), planes(scanner.threadPlanes()), bottom(planes.bottom), top(planes.top),
+          zEdge(planes.zEdge) {}
 
     /// Numbers the vertices of slabs [first, last) and visits their cubes (a run re-numbers
     /// its first plane's edges itself).
@@ -538,8 +559,10 @@ class Scanner {
 
     const Scanner& s;
     Output& out;
-    PlaneEdges bottom, top;             // planes z and z + 1 of the current slab
-    std::vector<std::uint32_t> zEdge;   // z-edges of the slab, rows j and j + 1 at j & 1
+    EdgePlanes& planes;                 // this thread's (threadPlanes)
+    PlaneEdges& bottom;                 // planes z and z + 1 of the current slab
+    PlaneEdges& top;
+    std::vector<std::uint32_t>& zEdge;  // z-edges of the slab, rows j and j + 1 at j & 1
     std::uint32_t vertex = 0;
   };
 
@@ -560,6 +583,7 @@ class Scanner {
   std::array<PatchJoins, 256> joins_{};
   std::vector<std::uint64_t> cubeMask_, voxelMask_;
   std::vector<std::uint64_t> bits_;  // planes z = -1 .. nz of rowCount_ rows of words_ words
+  mutable tbb::enumerable_thread_specific<EdgePlanes> planes_;  // threadPlanes
 };
 
 }  // namespace

@@ -200,7 +200,7 @@ void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mappin
                   const Selection& selection, double epsilon, Surface& out, int threads) {
   const ImageGeometry geometry = source.geometry();
   const std::size_t n = mesh.surfels.size();
-  resizeHugePages(out.vertices, n);  // written once (lib/HugePages.h)
+  resizeHugePages(out.vertices, n);  // fresh memory, 24 bytes a vertex (lib/HugePages.h)
   // Runs of up to 2^15 vertices, each placed on its own (the source may be read from several
   // threads at once); the same points for any number of threads.
   const std::size_t kRun = std::clamp<std::size_t>(n / 64, 1024, std::size_t(1) << 15);

@@ -20,6 +20,7 @@
 
 #include "BoundaryMapping.h"
 #include "FindSeed.h"
+#include "HugePages.h"
 #include "Image.h"
 #include "LabelSeeds.h"
 #include "LabelSelection.h"
@@ -177,9 +178,10 @@ std::vector<LabelSurface> scanAll(const VolumeRef<T>& image, const VoxelSource& 
   forEachIndex(arena, n, [&](std::size_t i) {
     out[i] = labelFields(geometry, LabelValue(counts.labels[i]), counts.voxels[i], o);
     Surface& s = out[i].surface;
-    s.vertices.resize(counts.surfels[i]);
-    s.surfels.resize(counts.surfels[i]);
-    s.triangles.resize(counts.triangles[i]);
+    // (Huge pages for a label's arrays of 2 MiB and more only: most labels' are smaller.)
+    resizeHugePages(s.vertices, counts.surfels[i]);
+    resizeHugePages(s.surfels, counts.surfels[i]);
+    resizeHugePages(s.triangles, counts.triangles[i]);
     arrays[i] = {s.surfels.data(), s.vertices.data(), s.triangles.data()};
   });
   cancelled();

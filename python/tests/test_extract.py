@@ -49,6 +49,34 @@ def test_every_thread_count_gives_the_same_surface():
         assert np.array_equal(s.vertices, ref.vertices) and np.array_equal(s.faces, ref.faces)
 
 
+def same_arrays(a, b):
+    """Byte for byte: the vertices, faces, surfels and per-component figures of two surfaces."""
+    return (np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces) and
+            np.array_equal(a.surfels, b.surfels) and a.components == b.components and
+            a.boundaries_in_image == b.boundaries_in_image)
+
+
+@pytest.mark.parametrize("seed", [11, 12, 13])
+def test_random_images_give_the_same_arrays_on_1_2_7_threads(seed):
+    # Noise (many boundaries, cut edges everywhere) on shapes whose slab count is below, near and
+    # above the scanner's runs (8 per thread), and a thresholded smooth image; threads 2 and 7
+    # split whatever the size (only threads=0 keeps small images on one thread).
+    rng = np.random.default_rng(seed)
+    shape = [(37, 29, 41), (5, 40, 33), (61, 3, 50)][seed - 11]
+    noise = rng.random(shape)
+    for volume, level in ((noise, 0.5), (smooth_volume(rng, shape), None)):
+        level = float(np.median(volume)) if level is None else level
+        for mapping in ("linear", "midpoint"):
+            ref = surftrack.extract(volume, level=level, mode="all", mapping=mapping, threads=1)
+            assert len(ref.vertices) > 1000
+            for threads in (2, 7):
+                s = surftrack.extract(volume, level=level, mode="all", mapping=mapping, threads=threads)
+                assert same_arrays(s, ref), (threads, mapping)
+        ref = surftrack.extract(volume, level=level, mode="largest", threads=1)
+        for threads in (2, 7):
+            assert same_arrays(surftrack.extract(volume, level=level, mode="largest", threads=threads), ref)
+
+
 @pytest.mark.parametrize("dtype", DTYPES)
 def test_every_dtype_gives_the_same_surface(dtype):
     volume = ball((14, 15, 16), (7, 7.5, 8), 4.5, dtype=np.uint8, value=1).astype(dtype)

@@ -45,6 +45,30 @@ def test_every_label_is_closed_and_counted(rng, dtype):
             assert s.euler == alone.euler
 
 
+@pytest.mark.parametrize("seed", [21, 22])
+def test_random_label_images_give_the_same_arrays_on_1_2_7_threads(seed):
+    # Noise labels (every voxel its own boundary, many labels per cube) and Voronoi cells with
+    # background specks, on shapes with fewer planes than slabs and more; every label's arrays
+    # byte for byte.
+    rng = np.random.default_rng(seed)
+    shape = [(9, 33, 27), (30, 14, 19)][seed - 21]
+    noise = rng.integers(0, 7, size=shape).astype(np.uint16)
+    cells = voronoi(rng, shape, 40, np.uint32)
+    cells[rng.random(shape) < 0.03] = 0
+    for labels in (noise, cells):
+        for boundaries in ("all", "largest"):
+            ref = surftrack.label_surfaces(labels, boundaries=boundaries, threads=1)
+            assert len(ref) > 5
+            for threads in (2, 7):
+                got = surftrack.label_surfaces(labels, boundaries=boundaries, threads=threads)
+                assert sorted(got) == sorted(ref)
+                for label, s in got.items():
+                    r = ref[label]
+                    assert np.array_equal(s.vertices, r.vertices) and np.array_equal(s.faces, r.faces)
+                    assert np.array_equal(s.surfels, r.surfels) and s.components == r.components
+                    assert s.voxels == r.voxels and s.boundaries_in_image == r.boundaries_in_image
+
+
 def test_touching_labels_share_their_interface_vertices(rng):
     labels = voronoi(rng, (16, 16, 16), 6, np.uint16)
     surfaces = surftrack.label_surfaces(labels)
