@@ -18,6 +18,7 @@
 #include <system_error>
 
 #include <surftrack/Extract.h>
+#include <surftrack/LabelBlockFiles.h>
 #include <surftrack/Labels.h>
 #include <surftrack/Refine.h>
 #include <surftrack/ThresholdBlocks.h>
@@ -679,6 +680,111 @@ py::dict mergeLabelFragmentsArrays(py::object label, py::list fragments, std::ar
   return d;
 }
 
+/// scanLabelBlock written to the fragment file `path` (writeLabelFragmentFile): per label,
+/// (label, keys, triangles) counts.
+py::list scanLabelBlockFile(py::array box, std::array<int, 3> origin, std::array<int, 3> volume,
+                            std::array<int, 3> lo, std::array<int, 3> hi, py::object background,
+                            const std::string& adjacency, const std::string& path) {
+  const VolumeView view = viewOfArray(box, kLastAxisFirst, {1, 1, 1}, {0, 0, 0}, {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}});
+  LabelOptions o;
+  o.background = labelOf(background, "background");
+  o.pair = parseAdjacencyPair(adjacency);
+  o.figures = false;
+  const Voxel v = engineVoxel(volume);
+  const Dims dims{v.x, v.y, v.z};
+  std::vector<std::array<std::uint64_t, 2>> counts;
+  std::vector<LabelValue> labels;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] {
+    const std::vector<LabelFragment> fragments =
+        scanLabelBlock(view, engineVoxel(origin), dims, engineVoxel(lo), engineVoxel(hi), o);
+    writeLabelFragmentFile(path, dims, engineVoxel(lo), engineVoxel(hi), fragments);
+    for (const LabelFragment& f : fragments) {
+      labels.push_back(f.label);
+      counts.push_back({f.keys.size(), f.triangles.size()});
+    }
+  });
+  py::list out;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    out.append(py::make_tuple(labelObject(labels[i]), counts[i][0], counts[i][1]));
+  return out;
+}
+
+/// The index of a fragment file (readFragmentFileIndex): per label, (label, keys, triangles).
+py::list fragmentFileSummary(const std::string& path) {
+  FragmentFileIndex index;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] { index = readFragmentFileIndex(path); });
+  py::list out;
+  for (const auto& e : index.entries) out.append(py::make_tuple(labelObject(e.label), e.keys, e.triangles));
+  return out;
+}
+
+/// mergeLabelFragmentFiles: `label` from its blocks' fragment files, as merge_label_fragments.
+py::dict mergeLabelFilesArrays(py::object label, const std::vector<std::string>& paths, std::array<double, 3> spacing,
+                               std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
+                               py::object background, const std::string& adjacency, bool figures) {
+  const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
+  LabelOptions o;
+  o.background = labelOf(background, "background");
+  o.pair = parseAdjacencyPair(adjacency);
+  o.figures = figures;
+  const LabelValue L = labelOf(label, "label");
+  auto r = std::make_shared<Result>();
+  r->order = kLastAxisFirst;
+  std::uint64_t voxels = 0;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] {
+    LabelSurface merged = mergeLabelFragmentFiles(L, paths, geometry, o);
+    voxels = merged.voxels;
+    r->surface = std::move(merged.surface);
+  });
+  py::dict d = surfaceDict(r);
+  d["voxels"] = voxels;
+  return d;
+}
+
+/// labelFiguresByTree: `label`'s figures from the fragment files of a grid of `block` voxels
+/// (array axes): voxels, the (K, 7) components table of surfaceDict, euler, vertices,
+/// triangles, levels, leaves.
+py::dict labelFiguresByTreeArrays(py::object label, const std::vector<std::string>& paths, std::array<int, 3> volume,
+                                  std::array<int, 3> block, std::array<double, 3> spacing,
+                                  std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
+                                  const std::string& adjacency, std::uint64_t budget) {
+  const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
+  LabelOptions o;
+  o.pair = parseAdjacencyPair(adjacency);
+  const LabelValue L = labelOf(label, "label");
+  const Voxel v = engineVoxel(volume), b = engineVoxel(block);
+  LabelFigures f;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] {
+    f = labelFiguresByTree(L, paths, Dims{v.x, v.y, v.z}, Dims{b.x, b.y, b.z}, geometry, o, budget);
+  });
+  py::array_t<double> components({py::ssize_t(f.components.size()), py::ssize_t(7)});
+  auto c = components.mutable_unchecked<2>();
+  long long euler = 0;
+  std::uint64_t vertices = 0, triangles = 0;
+  for (py::ssize_t i = 0; i < py::ssize_t(f.components.size()); ++i) {
+    const ComponentFigures& k = f.components[std::size_t(i)];
+    const double row[7] = {double(k.surfels), double(k.triangles), double(k.edges), double(k.euler),
+                           k.genus(), k.area, k.volume};
+    for (int j = 0; j < 7; ++j) c(i, j) = row[j];
+    euler += k.euler;
+    vertices += k.surfels;
+    triangles += k.triangles;
+  }
+  py::dict d;
+  d["voxels"] = f.voxels;
+  d["components"] = components;
+  d["euler"] = euler;
+  d["vertices"] = vertices;
+  d["triangles"] = triangles;
+  d["levels"] = f.levels;
+  d["leaves"] = f.leaves;
+  return d;
+}
+
 /// The options of a threshold block scan and its merge: every boundary of f > level.
 ExtractOptions thresholdBlockOptions(double level, const std::string& adjacency, const std::string& mapping,
                                      double epsilon, bool figures) {
@@ -871,6 +977,10 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("write_precomputed", &writePrecomputed);
   m.def("scan_label_block", &scanLabelBlockArray);
   m.def("merge_label_fragments", &mergeLabelFragmentsArrays);
+  m.def("scan_label_block_file", &scanLabelBlockFile);
+  m.def("fragment_file_summary", &fragmentFileSummary);
+  m.def("merge_label_files", &mergeLabelFilesArrays);
+  m.def("label_figures_by_tree", &labelFiguresByTreeArrays);
   m.def("scan_threshold_block", &scanThresholdBlockArray);
   m.def("merge_threshold_fragments", &mergeThresholdFragmentsArrays);
 }

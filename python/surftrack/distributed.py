@@ -46,7 +46,7 @@ def _fragment_path(work_dir, lo, run):
     """The fragment file of the block at `lo` in a run: `run` names what the fragments depend on
     (the kind of run, the array's shape and type, the block size, the selection, the pair), so
     that a work_dir reused with other arguments recomputes rather than reuses."""
-    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}_{run}.npz"
+    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}_{run}.frag"
 
 
 def _run_name(*what):
@@ -54,11 +54,9 @@ def _run_name(*what):
 
 
 def _summary(path):
-    """{label: (vertices, triangles)} of a fragment file."""
-    with np.load(path) as f:
-        labels = [int(s) for s in f["labels"]]
-        keys, tris = np.diff(f["key_offsets"]), np.diff(f["triangle_offsets"])
-    return {L: (int(k), int(t)) for L, k, t in zip(labels, keys, tris)}
+    """{label: (vertices, triangles)} of a fragment file (its index, checked: a damaged file is
+    a ValueError naming it)."""
+    return {L: (k, t) for L, k, t in _surftrack.fragment_file_summary(str(path))}
 
 
 def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir, run):
@@ -71,17 +69,11 @@ def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir, run):
     box = np.ascontiguousarray(source[lo[0]:top[0], lo[1]:top[1], lo[2]:top[2]])
     if box.dtype.kind not in "biu":
         raise ValueError(f"a label image needs integer voxels, not {box.dtype}")
-    fragments = _surftrack.scan_label_block(box, list(lo), list(shape), list(lo), list(hi), background, adjacency)
-    labels = np.array([str(f[0]) for f in fragments])  # decimal text: uint64 and int64 ids exact
-    key_offsets = np.cumsum([0] + [len(f[2]) for f in fragments], dtype=np.int64)
-    triangle_offsets = np.cumsum([0] + [len(f[3]) for f in fragments], dtype=np.int64)
-    temporary = path.with_name(f".{path.name}.{uuid.uuid4().hex}.npz")
-    np.savez(temporary, labels=labels, voxels=np.array([f[1] for f in fragments], dtype=np.uint64),
-             key_offsets=key_offsets, triangle_offsets=triangle_offsets,
-             keys=np.concatenate([f[2] for f in fragments]) if fragments else np.zeros(0, np.uint64),
-             triangles=np.concatenate([f[3] for f in fragments]) if fragments else np.zeros((0, 3), np.uint32))
-    os.replace(temporary, path)
-    return str(path), {f[0]: (len(f[2]), len(f[3])) for f in fragments}
+    # Scanned and written in C++ (core/include/surftrack/LabelBlockFiles.h: a flat file, written
+    # under a temporary name and renamed, the same bytes on a retry).
+    counts = _surftrack.scan_label_block_file(box, list(lo), list(shape), list(lo), list(hi), background, adjacency,
+                                              str(path))
+    return str(path), {L: (k, t) for L, k, t in counts}
 
 
 #: Fragment bytes a reduce task holds at most (about): the plan makes more shards than asked
@@ -90,7 +82,8 @@ _SHARD_BYTES = 512 << 20
 
 
 def _plan(results, shards):
-    """Task: the labels cut into shards, each a list of (label, its blocks' files). Labels in the
+    """Task: the labels cut into shards, each a list of (label, its blocks' files, its fragments'
+    bytes). Labels in the
     order of their first block (neighbours together, so that a shard reads few files), cut into
     runs of about equal fragment bytes: at least `shards` runs, and enough that none holds much
     more than _SHARD_BYTES (a keys entry is 8 bytes, a triangle 12)."""
@@ -104,7 +97,7 @@ def _plan(results, shards):
     count = max(1, min(len(labels), max(shards, -(-total // _SHARD_BYTES))))
     plan, run, filled = [], [], 0
     for label in labels:
-        run.append((label, [path for _, path in where[label]]))
+        run.append((label, [path for _, path in where[label]], weight[label]))
         filled += weight[label]
         if filled * count >= total * (len(plan) + 1) and len(plan) < count - 1:
             plan.append(run)
@@ -114,30 +107,29 @@ def _plan(results, shards):
     return plan
 
 
-def _shard_fragments(shard):
-    """(label, file) -> (voxels, keys, triangles) for every label of a shard, each file read
-    once (a label's fragments sliced out of it; the rest of the file dropped)."""
-    wanted = {}
-    for label, paths in shard:
-        for path in paths:
-            wanted.setdefault(path, set()).add(label)
-    out = {}
-    for path, labels in wanted.items():
-        with np.load(path) as f:
-            names = [int(s) for s in f["labels"]]
-            ko, to, voxels = f["key_offsets"], f["triangle_offsets"], f["voxels"]
-            keys, triangles = f["keys"], f["triangles"]
-            for i, label in enumerate(names):
-                if label in labels:
-                    out[label, path] = (int(voxels[i]), keys[ko[i]:ko[i + 1]].copy(),
-                                        triangles[to[i]:to[i + 1]].copy())
-    return out
-
-
-def _merge_label(label, fragments, geometry, background, adjacency, figures):
+def _merge_label(label, paths, geometry, background, adjacency, figures):
+    """A label's fragments read from its blocks' files and merged, all in C++ (no Python array
+    between the files and the mesh)."""
     spacing, origin, direction = geometry
-    return _surftrack.merge_label_fragments(label, fragments, spacing, origin, direction, background,
-                                            adjacency, figures)
+    return _surftrack.merge_label_files(label, list(paths), spacing, origin, direction, background, adjacency,
+                                        figures)
+
+
+def _tree_figures(label, paths, geometry, adjacency, grid, budget):
+    """The figures of a label whose fragments exceed `budget` bytes, without its mesh: merged by
+    cells of blocks of at most `budget` bytes, combined up an octree (docs/theory.md, "A label
+    larger than one merge"); counts exact, area and volume summed in another order."""
+    spacing, origin, direction = geometry
+    shape, block = grid
+    f = _surftrack.label_figures_by_tree(label, list(paths), list(shape), list(block), spacing, origin, direction,
+                                         adjacency, int(budget))
+    table = np.asarray(f["components"]).reshape(-1, 7)
+    area = volume = 0.0
+    for row in table:  # summed in the order the command line's table sums them
+        area += float(row[5])
+        volume += float(row[6])
+    return {"voxels": f["voxels"], "vertices": f["vertices"], "triangles": f["triangles"], "euler": f["euler"],
+            "boundaries": len(table), "area": area, "volume": volume, "file": None, "levels": f["levels"]}
 
 
 def _file_name(label, naming):
@@ -149,15 +141,17 @@ def _file_name(label, naming):
     return f"{label}_{name.replace('/', '_').replace(' ', '_').replace(chr(92), '_')}.ply"
 
 
-def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None):
+def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None, budget=None, grid=None):
     """Task: every label of a shard merged; written into `out_dir` (named by _file_name) when it
-    is given (the files only, returned as figures), else the surfaces' fields returned."""
+    is given (the files only, returned as figures), else the surfaces' fields returned. A label
+    whose fragments exceed `budget` bytes gets its figures only (_tree_figures, "file" None)."""
     from . import Surface
     out = {}
-    fragments = _shard_fragments(shard)
-    for label, paths in shard:
-        fields = _merge_label(label, [fragments.pop((label, p)) for p in paths], geometry, background,
-                              adjacency, figures)
+    for label, paths, weight in shard:
+        if budget is not None and weight > budget:
+            out[label] = _tree_figures(label, paths, geometry, adjacency, grid, budget)
+            continue
+        fields = _merge_label(label, paths, geometry, background, adjacency, figures)
         if out_dir is None:  # plain arrays through the scheduler (the C++ result does not pickle)
             result = fields.pop("result")
             fields["surfels"], fields["normals"] = result.surfels(), result.normals()
@@ -227,7 +221,7 @@ def _map_blocks(client, task, source, blocks, args, progress):
 
 
 def _run(source, *, block, spacing, origin, direction, background, adjacency, figures, client, workers,
-         work_dir, out_dir, shards, progress, naming=None):
+         work_dir, out_dir, shards, progress, naming=None, merge_budget=None):
     from dask.distributed import as_completed
     from . import _geometry
 
@@ -243,7 +237,7 @@ def _run(source, *, block, spacing, origin, direction, background, adjacency, fi
         plan = client.submit(_plan, futures, shards or max(1, 2 * len(client.scheduler_info()["workers"])), pure=False)
         shard_list = plan.result()
         reduced = [client.submit(_reduce_shard, s, geometry, background, adjacency, figures, out_dir, naming,
-                                 pure=False) for s in shard_list]
+                                 merge_budget, (shape, tuple(block)), pure=False) for s in shard_list]
         out, merged, total = {}, 0, sum(len(s) for s in shard_list)
         for future in as_completed(reduced):
             part = future.result()
@@ -288,11 +282,17 @@ def label_surfaces(labels, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0), or
 
 def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0),
                        origin=(0.0, 0.0, 0.0), direction=None, background=0, adjacency="26-6", client=None,
-                       workers=None, work_dir=None, shards=None, progress=None) -> dict:
+                       workers=None, work_dir=None, shards=None, progress=None, merge_budget=None) -> dict:
     """Every label's surface written as ``out_dir/label_<L>.ply`` by the reduce tasks, each file
     byte-identical to ``surftrack.label_surfaces(labels, ...)[L].write(...)`` on the whole array.
     ``out_dir`` (shared by the workers) must not exist or be empty; it appears whole at the end
-    or not at all. Returns label -> figures (voxels, vertices, triangles, euler)."""
+    or not at all. Returns label -> figures (voxels, vertices, triangles, euler, boundaries, area,
+    volume, file). ``merge_budget`` (bytes, None: no limit): a label whose fragments take more
+    is not merged whole: its figures are computed over a tree of groups of blocks of at most
+    that many bytes each (docs/theory.md, "A label larger than one merge"; counts exact, area
+    and volume up to rounding), its mesh is not written ("file" None, "levels" the tree's)."""
+    if merge_budget is not None and (isinstance(merge_budget, bool) or int(merge_budget) < 0):
+        raise ValueError(f"merge_budget must be a number of bytes (>= 0) or None, not {merge_budget!r}")
     target = Path(out_dir)
     if target.exists() and (not target.is_dir() or any(target.iterdir())):
         raise ValueError(f"cannot write into '{out_dir}': it exists and is not an empty directory")
@@ -303,7 +303,7 @@ def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 
             figures = _run(labels, block=block, spacing=spacing, origin=origin, direction=direction,
                            background=background, adjacency=adjacency, figures=True, client=client,
                            workers=workers, work_dir=work, out_dir=str(staging), shards=shards,
-                           progress=progress)
+                           progress=progress, merge_budget=merge_budget)
         os.replace(staging, target)  # replaces an empty directory
     except BaseException:
         for f in staging.glob("*"):
