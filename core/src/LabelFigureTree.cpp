@@ -160,7 +160,7 @@ class Tree {
         into.volume += part.volume;
         into.firstKey = std::min(into.firstKey, part.firstKey);
       }
-      Partial().parts.swap(c.parts);
+      std::vector<Part>().swap(c.parts);
       std::vector<std::pair<std::uint64_t, std::uint32_t>>().swap(c.border);
     }
     for (std::size_t i = 0; i < border.size(); ++i) {

@@ -4,6 +4,7 @@
 // (docs/performance.md, "Label maps by blocks on Dask"). Every length is checked against the
 // file's size and every byte against a checksum before use, so a truncated or damaged file is
 // a one-line error naming it, never a crash or a wrong mesh.
+#include <algorithm>
 #include <bit>
 #include <cstdio>
 #include <cstring>
