@@ -4,7 +4,8 @@ merge_label_files and label_figures_by_tree, without Dask:
 
 - a label merged from the files is label_surfaces' surface of the whole volume, array for array;
 - a block written twice gives the same bytes and leaves no temporary file;
-- every truncation, every single-bit flip anywhere in a file, a byte appended, another version,
+- truncations and single-bit flips at every byte of a file's header and index and throughout
+  its data, a byte appended, another version,
   another kind of file: a ValueError naming the file, never a crash or a wrong mesh;
 - the figures by the tree of groups of blocks, with budgets forcing 1, 2 and 3 levels (and
   random budgets), against the single pass on random label images: vertex, triangle, edge counts,
@@ -81,12 +82,15 @@ def test_a_block_written_twice_gives_the_same_bytes(tmp_path):
 def reads_everything(path, labels):
     """Every label of the file read and merged (one file as the whole volume's one block)."""
     for label, _, _ in _surftrack.fragment_file_summary(path):
-        _surftrack.merge_label_files(label, [path], [1.0] * 3, [0.0] * 3, IDENTITY, 0, "26-6", True)
+        _surftrack.merge_label_files(label, [path], [1.0] * 3, [0.0] * 3, IDENTITY, 0, "26-6", False)
 
 
 def test_damaged_files_are_refused_by_name(tmp_path):
     rng = np.random.default_rng(11)
-    labels = random_labels(rng, (6, 5, 7))
+    labels = np.zeros((5, 4, 6), np.uint64)  # three labels, 2^64 - 1 among them
+    labels[1:3, 1:3, 1:4] = 2**64 - 1
+    labels[3, 2, 2] = 5
+    labels[0, 0, 0] = 2
     (path,) = write_blocks(labels, labels.shape, tmp_path)  # one block: the file is the volume's
     reads_everything(path, labels)
     good = open(path, "rb").read()
@@ -99,11 +103,15 @@ def test_damaged_files_are_refused_by_name(tmp_path):
             reads_everything(damaged, labels)
         assert "damaged.frag" in str(e.value)
 
-    for n in range(len(good)):  # every truncation
+    # Every position in the header and index (80 + 56 bytes a label), every 8th (truncations) or
+    # 4th (flips) in the data, which one checksum per label covers, and the last 12 bytes.
+    head = 80 + 56 * 3
+    assert len(good) > head + 200
+    tail = list(range(len(good) - 12, len(good)))
+    for n in [*range(head + 8), *range(head + 8, len(good) - 12, 8), *tail]:
         refused(good[:n], "truncated|not a surftrack fragment file")
     refused(good + b"\0", "corrupted")
-    positions = range(len(good)) if len(good) <= 4096 else rng.choice(len(good), 4096, replace=False)
-    for at in positions:  # a bit flipped anywhere (the bit varies with the position)
+    for at in [*range(head + 8), *range(head + 8, len(good) - 12, 4), *tail]:  # the bit varies with the byte
         data = bytearray(good)
         data[at] ^= 1 << (at % 8)
         refused(bytes(data), "truncated|corrupted|not a surftrack|version")
