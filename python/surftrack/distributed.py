@@ -42,11 +42,12 @@ def block_grid(shape, block):
     return [(tuple(a[0] for a in c), tuple(a[1] for a in c)) for c in itertools.product(*axes)]
 
 
-def _fragment_path(work_dir, lo, run):
+def _fragment_path(work_dir, lo, run, suffix=".frag"):
     """The fragment file of the block at `lo` in a run: `run` names what the fragments depend on
     (the kind of run, the array's shape and type, the block size, the selection, the pair), so
-    that a work_dir reused with other arguments recomputes rather than reuses."""
-    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}_{run}.frag"
+    that a work_dir reused with other arguments recomputes rather than reuses. Label maps' files
+    are the engine's fragment files (.frag); thresholds' are still numpy's .npz."""
+    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}_{run}{suffix}"
 
 
 def _run_name(*what):
@@ -315,8 +316,8 @@ def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 
 
 def _threshold_block(source, lo, hi, shape, level, adjacency, mapping, epsilon, work_dir, run):
     """Task: the fragment of one block of a threshold's every boundary (docs/theory.md,
-    "Thresholds by blocks"), written to its file as _mesh_block writes its own."""
-    path = _fragment_path(work_dir, lo, run)
+    "Thresholds by blocks"), written to its file atomically as _mesh_block writes its own."""
+    path = _fragment_path(work_dir, lo, run, ".npz")
     if not path.exists():
         top = [min(h + 1, n) for h, n in zip(hi, shape)]  # the one-voxel apron on the high sides
         box = np.asarray(source[lo[0]:top[0], lo[1]:top[1], lo[2]:top[2]])

@@ -180,13 +180,21 @@ def test_labels_over_the_merge_budget_get_exact_figures_from_the_tree(client, tm
     labels = np.argmin(((grid - seeds[None]) ** 2).sum(-1), axis=1).reshape(shape).astype(np.int32) - 2
     labels[rng.random(shape) < 0.05] = 7  # specks: many components
     want = surftrack.label_surfaces(labels, spacing=(2.0, 1.0, 0.5))
-    sizes = sorted(12 * len(w.faces) for w in want.values())
-    budget = sizes[len(sizes) // 2]  # about half the labels exceed it
+    # A first run writes the fragment files, whose sizes set a budget half the labels exceed.
+    work = tmp_path / "work"
+    blocks.write_label_meshes(labels, tmp_path / "first", block=(4, 5, 3), client=client, work_dir=work)
+    weight = {}
+    for path in work.iterdir():
+        for label, keys, triangles in surftrack._surftrack.fragment_file_summary(str(path)):
+            weight[label] = weight.get(label, 0) + 8 * keys + 12 * triangles
+    sizes = sorted(weight.values())
+    budget = (sizes[len(sizes) // 2 - 1] + sizes[len(sizes) // 2]) // 2
     figures = blocks.write_label_meshes(labels, tmp_path / "out", block=(4, 5, 3), spacing=(2.0, 1.0, 0.5),
-                                        client=client, merge_budget=budget)
+                                        client=client, work_dir=work, merge_budget=budget)
     assert sorted(figures) == sorted(want)
     by_tree = [L for L, f in figures.items() if f["file"] is None]
-    assert 0 < len(by_tree) < len(want) and all(figures[L]["levels"] >= 1 for L in by_tree)
+    assert sorted(by_tree) == sorted(L for L in weight if weight[L] > budget) and 0 < len(by_tree) < len(want)
+    assert all(figures[L]["levels"] >= 1 for L in by_tree)
     for label, w in want.items():
         f = figures[label]
         assert (f["voxels"], f["vertices"], f["triangles"], f["euler"], f["boundaries"]) == \
