@@ -720,10 +720,13 @@ py::list fragmentFileSummary(const std::string& path) {
   return out;
 }
 
-/// mergeLabelFragmentFiles: `label` from its blocks' fragment files, as merge_label_fragments.
+/// mergeLabelFragmentFiles: `label` from its blocks' fragment files, as merge_label_fragments;
+/// written to `path` too when one is given (writeSurface, the bytes of Surface.write, without
+/// the arrays' round trip through Python).
 py::dict mergeLabelFilesArrays(py::object label, const std::vector<std::string>& paths, std::array<double, 3> spacing,
                                std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
-                               py::object background, const std::string& adjacency, bool figures) {
+                               py::object background, const std::string& adjacency, bool figures,
+                               const std::string& path, bool binary) {
   const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
   LabelOptions o;
   o.background = labelOf(background, "background");
@@ -738,6 +741,7 @@ py::dict mergeLabelFilesArrays(py::object label, const std::vector<std::string>&
     LabelSurface merged = mergeLabelFragmentFiles(L, paths, geometry, o);
     voxels = merged.voxels;
     r->surface = std::move(merged.surface);
+    if (!path.empty()) writeSurface(r->surface, path, binary, &cancel);
   });
   py::dict d = surfaceDict(r);
   d["voxels"] = voxels;
@@ -979,7 +983,9 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("merge_label_fragments", &mergeLabelFragmentsArrays);
   m.def("scan_label_block_file", &scanLabelBlockFile);
   m.def("fragment_file_summary", &fragmentFileSummary);
-  m.def("merge_label_files", &mergeLabelFilesArrays);
+  m.def("merge_label_files", &mergeLabelFilesArrays, py::arg("label"), py::arg("paths"), py::arg("spacing"),
+        py::arg("origin"), py::arg("direction"), py::arg("background"), py::arg("adjacency"), py::arg("figures"),
+        py::arg("path") = "", py::arg("binary") = true);
   m.def("label_figures_by_tree", &labelFiguresByTreeArrays);
   m.def("scan_threshold_block", &scanThresholdBlockArray);
   m.def("merge_threshold_fragments", &mergeThresholdFragmentsArrays);

@@ -108,12 +108,13 @@ def _plan(results, shards):
     return plan
 
 
-def _merge_label(label, paths, geometry, background, adjacency, figures):
+def _merge_label(label, paths, geometry, background, adjacency, figures, out_path="", binary=True):
     """A label's fragments read from its blocks' files and merged, all in C++ (no Python array
-    between the files and the mesh)."""
+    between the files and the mesh), and written to `out_path` when given (the bytes of
+    Surface.write, from the engine's arrays)."""
     spacing, origin, direction = geometry
     return _surftrack.merge_label_files(label, list(paths), spacing, origin, direction, background, adjacency,
-                                        figures)
+                                        figures, out_path, binary)
 
 
 def _tree_figures(label, paths, geometry, adjacency, grid, budget):
@@ -146,28 +147,28 @@ def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, nami
     """Task: every label of a shard merged; written into `out_dir` (named by _file_name) when it
     is given (the files only, returned as figures), else the surfaces' fields returned. A label
     whose fragments exceed `budget` bytes gets its figures only (_tree_figures, "file" None)."""
-    from . import Surface
     out = {}
     for label, paths, weight in shard:
         if budget is not None and weight > budget:
             out[label] = _tree_figures(label, paths, geometry, adjacency, grid, budget)
             continue
-        fields = _merge_label(label, paths, geometry, background, adjacency, figures)
         if out_dir is None:  # plain arrays through the scheduler (the C++ result does not pickle)
+            fields = _merge_label(label, paths, geometry, background, adjacency, figures)
             result = fields.pop("result")
             fields["surfels"], fields["normals"] = result.surfels(), result.normals()
             out[label] = fields
             continue
-        surface = Surface(**fields)
         file = _file_name(label, naming)
-        surface.write(str(Path(out_dir) / file), binary=naming["binary"] if naming else True)
+        fields = _merge_label(label, paths, geometry, background, adjacency, figures, str(Path(out_dir) / file),
+                              naming["binary"] if naming else True)
+        table = np.asarray(fields["components"]).reshape(-1, 7)  # as Surface.components holds them
         area = volume = 0.0
-        for c in surface.components:  # summed in the order the command line's table sums them
-            area += c["area"]
-            volume += c["volume"]
-        out[label] = {"voxels": fields["voxels"], "vertices": len(surface.vertices),
-                      "triangles": len(surface.faces), "euler": fields["euler"],
-                      "boundaries": len(surface.components), "area": area, "volume": volume, "file": file}
+        for row in table:  # summed in the order the command line's table sums them
+            area += float(row[5])
+            volume += float(row[6])
+        out[label] = {"voxels": fields["voxels"], "vertices": len(fields["vertices"]),
+                      "triangles": len(fields["faces"]), "euler": fields["euler"],
+                      "boundaries": len(table), "area": area, "volume": volume, "file": file}
     return out
 
 
