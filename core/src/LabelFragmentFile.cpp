@@ -35,7 +35,7 @@ std::uint64_t checksum(const void* data, std::size_t bytes, std::uint64_t h = 0x
     h = mix64(h ^ w) + i;
   }
   std::uint64_t tail = 0;
-  std::memcpy(&tail, p + i, bytes - i);
+  if (bytes > i) std::memcpy(&tail, p + i, bytes - i);  // (an empty vector's data may be null)
   return mix64(h ^ tail ^ (std::uint64_t(bytes) << 56));
 }
 
@@ -131,8 +131,9 @@ void writeLabelFragmentFile(const std::string& path, Dims volume, Voxel lo, Voxe
     if (!out.f) throw std::runtime_error("cannot write the fragment file '" + temporary + "'");
     bool ok = std::fwrite(head.data(), 1, head.size(), out.f) == head.size();
     for (const LabelFragment& f : fragments) {
-      ok = ok && std::fwrite(f.keys.data(), 8, f.keys.size(), out.f) == f.keys.size();
-      ok = ok && std::fwrite(f.triangles.data(), 12, f.triangles.size(), out.f) == f.triangles.size();
+      ok = ok && (f.keys.empty() || std::fwrite(f.keys.data(), 8, f.keys.size(), out.f) == f.keys.size());
+      ok = ok && (f.triangles.empty() ||
+                  std::fwrite(f.triangles.data(), 12, f.triangles.size(), out.f) == f.triangles.size());
     }
     ok = std::fflush(out.f) == 0 && ok;
     ok = std::fclose(out.f) == 0 && ok;
@@ -185,6 +186,9 @@ FragmentFileIndex readFragmentFileIndex(const std::string& path) {
   std::memset(head.data() + kHeaderBytes - 8, 0, 8);
   if (checksum(head.data(), head.size()) != sum) bad(path, "corrupted (header or index checksum)");
 
+  for (int a = 0; a < 3; ++a)
+    if (index.volume[a] < 1 || index.lo[a] < 0 || index.lo[a] >= index.hi[a] || index.hi[a] > index.volume[a])
+      bad(path, "corrupted (its block is not in its volume)");
   std::uint64_t offset = kHeaderBytes + kEntryBytes * count;
   p = head.data() + kHeaderBytes;
   index.entries.resize(count);
