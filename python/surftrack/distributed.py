@@ -13,7 +13,10 @@ The graph: one task per block (reads its box from the array — a zarr array, or
 as numpy is — and writes one fragment file; a block whose file exists is not computed again, so
 a stopped run resumes), one plan task, one task per shard of labels (reads its labels' fragments
 from the files, merges, writes or returns). Fragments go through the file system, never through
-the scheduler: ``work_dir`` must be shared by every worker.
+the scheduler: ``work_dir`` must be shared by every worker. A block's file is the engine's flat
+fragment file (core/include/surftrack/LabelBlockFiles.h), written and read in C++. A label whose
+fragments exceed ``merge_budget`` gets its exact figures from a tree of groups of blocks instead
+of a merged mesh (docs/theory.md, "A label larger than one merge").
 """
 from __future__ import annotations
 

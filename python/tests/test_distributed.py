@@ -3,7 +3,8 @@ against surftrack.label_surfaces on the whole array (the single pass): the same 
 label and pair on random label images cut into blocks the shape does not divide (1-voxel-thick
 blocks and a single block included), byte-identical PLY files from a zarr store, uint64 ids
 around 2^53 and 2^64 - 1 exact, a resumed run that recomputes no finished block, a worker killed
-mid-run that changes nothing, and bad input refused before the run."""
+mid-run that changes nothing, bad input refused before the run, and labels over a merge budget
+given the single pass's figures by the tree of groups of blocks."""
 import os
 import zlib
 from pathlib import Path
