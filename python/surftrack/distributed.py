@@ -87,9 +87,8 @@ _SHARD_BYTES = 512 << 20
 
 def _plan(results, shards):
     """Task: the labels cut into shards, each a list of (label, its blocks' files, its fragments'
-    bytes). Labels in the
-    order of their first block (neighbours together, so that a shard reads few files), cut into
-    runs of about equal fragment bytes: at least `shards` runs, and enough that none holds much
+    bytes). Labels in the order of their first block (neighbours together, so that a shard reads
+    few files), cut into runs of about equal fragment bytes: at least `shards` runs, and enough that none holds much
     more than _SHARD_BYTES (a keys entry is 8 bytes, a triangle 12)."""
     where, weight = {}, {}
     for order, (path, summary) in enumerate(results):
@@ -128,13 +127,20 @@ def _tree_figures(label, paths, geometry, adjacency, grid, budget):
     shape, block = grid
     f = _surftrack.label_figures_by_tree(label, list(paths), list(shape), list(block), spacing, origin, direction,
                                          adjacency, int(budget))
-    table = np.asarray(f["components"]).reshape(-1, 7)
+    boundaries, area, volume = _component_sums(f["components"])
+    return {"voxels": f["voxels"], "vertices": f["vertices"], "triangles": f["triangles"], "euler": f["euler"],
+            "boundaries": boundaries, "area": area, "volume": volume, "file": None, "levels": f["levels"]}
+
+
+def _component_sums(components):
+    """The number of components of a (K, 7) figures table (as Surface holds it) and their area
+    and volume, summed in the order the command line's table sums them."""
+    table = np.asarray(components).reshape(-1, 7)
     area = volume = 0.0
-    for row in table:  # summed in the order the command line's table sums them
+    for row in table:
         area += float(row[5])
         volume += float(row[6])
-    return {"voxels": f["voxels"], "vertices": f["vertices"], "triangles": f["triangles"], "euler": f["euler"],
-            "boundaries": len(table), "area": area, "volume": volume, "file": None, "levels": f["levels"]}
+    return len(table), area, volume
 
 
 def _file_name(label, naming):
@@ -164,14 +170,10 @@ def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, nami
         file = _file_name(label, naming)
         fields = _merge_label(label, paths, geometry, background, adjacency, figures, str(Path(out_dir) / file),
                               naming["binary"] if naming else True)
-        table = np.asarray(fields["components"]).reshape(-1, 7)  # as Surface.components holds them
-        area = volume = 0.0
-        for row in table:  # summed in the order the command line's table sums them
-            area += float(row[5])
-            volume += float(row[6])
+        boundaries, area, volume = _component_sums(fields["components"])
         out[label] = {"voxels": fields["voxels"], "vertices": len(fields["vertices"]),
                       "triangles": len(fields["faces"]), "euler": fields["euler"],
-                      "boundaries": len(table), "area": area, "volume": volume, "file": file}
+                      "boundaries": boundaries, "area": area, "volume": volume, "file": file}
     return out
 
 
