@@ -17,3 +17,14 @@ std::vector<std::uint32_t> triangleComponents(std::size_t vertexCount,
                                               std::size_t& count);
 
 }  // namespace surftrack
+
+namespace surftrack {
+
+/// The same union-find over `elementCount` elements joined in pairs: the component of each,
+/// numbered in the order of their smallest element (the partial components of a label joined
+/// through shared border keys, docs/theory.md "A label larger than one merge").
+std::vector<std::uint32_t> joinedComponents(std::size_t elementCount,
+                                            const std::vector<std::array<std::uint32_t, 2>>& joins,
+                                            std::size_t& count);
+
+}  // namespace surftrack

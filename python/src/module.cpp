@@ -15,6 +15,7 @@
 #include <system_error>
 
 #include <surftrack/Extract.h>
+#include <surftrack/LabelBlockFiles.h>
 #include <surftrack/Labels.h>
 #include <surftrack/Refine.h>
 #include <surftrack/ThresholdBlocks.h>
@@ -107,6 +108,20 @@ struct Result {
 };
 
 /// The arrays and figures of an extracted surface, as the keyword arguments of Python's Surface.
+/// The figures as one (K, 7) array (a dict per component would cost more than the scan on
+/// images with millions of noise specks); the Python layer makes dicts on first use.
+py::array_t<double> componentsTable(const std::vector<ComponentFigures>& figures) {
+  py::array_t<double> components({py::ssize_t(figures.size()), py::ssize_t(7)});
+  auto c = components.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < py::ssize_t(figures.size()); ++i) {
+    const ComponentFigures& f = figures[std::size_t(i)];
+    const double row[7] = {double(f.surfels), double(f.triangles), double(f.edges), double(f.euler),
+                           f.genus(), f.area, f.volume};
+    for (int k = 0; k < 7; ++k) c(i, k) = row[k];
+  }
+  return components;
+}
+
 py::dict surfaceDict(const std::shared_ptr<Result>& r) {
   const Surface& s = r->surface;
   const py::ssize_t n = py::ssize_t(s.vertices.size()), m = py::ssize_t(s.triangles.size());
@@ -115,18 +130,7 @@ py::dict surfaceDict(const std::shared_ptr<Result>& r) {
   // (A surface is never empty: extract() and extractLabels() throw instead.)
   py::array vertices = viewOf(const_cast<double*>(s.vertices.front().data()), {n, 3}, r);
   py::array faces = viewOf(const_cast<std::uint32_t*>(s.triangles.front().data()), {m, 3}, r);
-  // The figures as one (K, 7) array (a dict per component would cost more than the scan on
-  // images with millions of noise specks); the Python layer makes dicts on first use.
-  py::array_t<double> components({py::ssize_t(s.components.size()), py::ssize_t(7)});
-  {
-    auto c = components.mutable_unchecked<2>();
-    for (py::ssize_t i = 0; i < py::ssize_t(s.components.size()); ++i) {
-      const ComponentFigures& f = s.components[std::size_t(i)];
-      const double row[7] = {double(f.surfels), double(f.triangles), double(f.edges), double(f.euler),
-                             f.genus(), f.area, f.volume};
-      for (int k = 0; k < 7; ++k) c(i, k) = row[k];
-    }
-  }
+  py::array_t<double> components = componentsTable(s.components);
   py::dict timings;
   for (const StageTime& t : s.timings) timings[py::str(t.stage)] = t.seconds;
   py::dict out;
@@ -458,10 +462,10 @@ Voxel engineVoxel(const std::array<int, 3>& zyx) { return Voxel{zyx[2], zyx[1], 
 
 /// scanLabelBlock (docs/theory.md, "Label maps by blocks") on `box`, the voxels [origin,
 /// origin + box.shape) of a volume of shape `volume`, owning the cubes of [lo, hi) (all in array
-/// axes): per label, (label, voxels, keys (uint64), triangles ((M, 3) uint32)).
-py::list scanLabelBlockArray(py::array box, std::array<int, 3> origin, std::array<int, 3> volume,
-                             std::array<int, 3> lo, std::array<int, 3> hi, py::object background,
-                             const std::string& adjacency) {
+/// axes), with the pair and background given.
+std::vector<LabelFragment> scanBlockOfArray(py::array box, std::array<int, 3> origin, std::array<int, 3> volume,
+                                            std::array<int, 3> lo, std::array<int, 3> hi, py::object background,
+                                            const std::string& adjacency) {
   const VolumeView view = viewOfArray(box, kLastAxisFirst, {1, 1, 1}, {0, 0, 0}, {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}});
   LabelOptions o;
   o.background = labelOf(background, "background");
@@ -473,6 +477,14 @@ py::list scanLabelBlockArray(py::array box, std::array<int, 3> origin, std::arra
   runEngine(kLastAxisFirst, cancel, [&] {
     fragments = scanLabelBlock(view, engineVoxel(origin), Dims{v.x, v.y, v.z}, engineVoxel(lo), engineVoxel(hi), o);
   });
+  return fragments;
+}
+
+/// scanBlockOfArray: per label, (label, voxels, keys (uint64), triangles ((M, 3) uint32)).
+py::list scanLabelBlockArray(py::array box, std::array<int, 3> origin, std::array<int, 3> volume,
+                             std::array<int, 3> lo, std::array<int, 3> hi, py::object background,
+                             const std::string& adjacency) {
+  std::vector<LabelFragment> fragments = scanBlockOfArray(box, origin, volume, lo, hi, background, adjacency);
   py::list out;
   for (LabelFragment& f : fragments) {
     py::array_t<std::uint64_t> keys(py::ssize_t(f.keys.size()));
@@ -498,16 +510,42 @@ ImageGeometry geometryOfArrayAxes(const std::array<double, 3>& spacing, const st
   return geometry;
 }
 
+/// A merged label (`merge()`, run as engine work) as surfaceDict with its voxels; written to
+/// `path` too when one is given (writeSurface: the bytes of Surface.write, without the arrays'
+/// round trip through Python).
+template <class Merge>
+py::dict mergedLabelDict(Merge&& merge, const std::string& path = "", bool binary = true) {
+  auto r = std::make_shared<Result>();
+  r->order = kLastAxisFirst;
+  std::uint64_t voxels = 0;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] {
+    LabelSurface merged = merge();
+    voxels = merged.voxels;
+    r->surface = std::move(merged.surface);
+    if (!path.empty()) writeSurface(r->surface, path, binary, &cancel);
+  });
+  py::dict d = surfaceDict(r);
+  d["voxels"] = voxels;
+  return d;
+}
+
+/// The options of a label's merge (its pair and figures; the background as the blocks').
+LabelOptions labelMergeOptions(py::object background, const std::string& adjacency, bool figures) {
+  LabelOptions o;
+  o.background = labelOf(background, "background");
+  o.pair = parseAdjacencyPair(adjacency);
+  o.figures = figures;
+  return o;
+}
+
 /// mergeLabelFragments: the fragments (voxels, keys, triangles) of `label` from every block of a
 /// partition, as label_surfaces_array gives that label (geometry in array axes).
 py::dict mergeLabelFragmentsArrays(py::object label, py::list fragments, std::array<double, 3> spacing,
                                    std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
                                    py::object background, const std::string& adjacency, bool figures) {
   const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
-  LabelOptions o;
-  o.background = labelOf(background, "background");
-  o.pair = parseAdjacencyPair(adjacency);
-  o.figures = figures;
+  const LabelOptions o = labelMergeOptions(background, adjacency, figures);
   const LabelValue L = labelOf(label, "label");
   std::vector<LabelFragment> parts;
   for (py::handle h : fragments) {
@@ -524,17 +562,80 @@ py::dict mergeLabelFragmentsArrays(py::object label, py::list fragments, std::ar
     if (!f.triangles.empty()) std::memcpy(f.triangles.data(), triangles.data(), f.triangles.size() * 12);
     parts.push_back(std::move(f));
   }
-  auto r = std::make_shared<Result>();
-  r->order = kLastAxisFirst;
-  std::uint64_t voxels = 0;
+  return mergedLabelDict([&] { return mergeLabelFragments(parts, geometry, o); });
+}
+
+/// scanLabelBlock written to the fragment file `path` (writeLabelFragmentFile): per label,
+/// (label, keys, triangles) counts.
+py::list scanLabelBlockFile(py::array box, std::array<int, 3> origin, std::array<int, 3> volume,
+                            std::array<int, 3> lo, std::array<int, 3> hi, py::object background,
+                            const std::string& adjacency, const std::string& path) {
+  const std::vector<LabelFragment> fragments = scanBlockOfArray(box, origin, volume, lo, hi, background, adjacency);
+  const Voxel v = engineVoxel(volume);
+  std::atomic<bool> cancel{false};
+  runWatchingSignals(cancel, [&] {
+    writeLabelFragmentFile(path, Dims{v.x, v.y, v.z}, engineVoxel(lo), engineVoxel(hi), fragments);
+  });
+  py::list out;
+  for (const LabelFragment& f : fragments)
+    out.append(py::make_tuple(labelObject(f.label), f.keys.size(), f.triangles.size()));
+  return out;
+}
+
+/// The index of a fragment file (readFragmentFileIndex): per label, (label, keys, triangles).
+py::list fragmentFileSummary(const std::string& path) {
+  FragmentFileIndex index;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] { index = readFragmentFileIndex(path); });
+  py::list out;
+  for (const auto& e : index.entries) out.append(py::make_tuple(labelObject(e.label), e.keys, e.triangles));
+  return out;
+}
+
+/// mergeLabelFragmentFiles: `label` from its blocks' fragment files, as merge_label_fragments;
+/// written to `path` too when one is given (mergedLabelDict).
+py::dict mergeLabelFilesArrays(py::object label, const std::vector<std::string>& paths, std::array<double, 3> spacing,
+                               std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
+                               py::object background, const std::string& adjacency, bool figures,
+                               const std::string& path, bool binary) {
+  const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
+  const LabelOptions o = labelMergeOptions(background, adjacency, figures);
+  const LabelValue L = labelOf(label, "label");
+  return mergedLabelDict([&] { return mergeLabelFragmentFiles(L, paths, geometry, o); }, path, binary);
+}
+
+/// labelFiguresByTree: `label`'s figures from the fragment files of a grid of `block` voxels
+/// (array axes): voxels, the (K, 7) components table of surfaceDict, euler, vertices,
+/// triangles, levels, leaves.
+py::dict labelFiguresByTreeArrays(py::object label, const std::vector<std::string>& paths, std::array<int, 3> volume,
+                                  std::array<int, 3> block, std::array<double, 3> spacing,
+                                  std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
+                                  const std::string& adjacency, std::uint64_t budget) {
+  const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
+  LabelOptions o;
+  o.pair = parseAdjacencyPair(adjacency);
+  const LabelValue L = labelOf(label, "label");
+  const Voxel v = engineVoxel(volume), b = engineVoxel(block);
+  LabelFigures f;
   std::atomic<bool> cancel{false};
   runEngine(kLastAxisFirst, cancel, [&] {
-    LabelSurface merged = mergeLabelFragments(parts, geometry, o);
-    voxels = merged.voxels;
-    r->surface = std::move(merged.surface);
+    f = labelFiguresByTree(L, paths, Dims{v.x, v.y, v.z}, Dims{b.x, b.y, b.z}, geometry, o, budget);
   });
-  py::dict d = surfaceDict(r);
-  d["voxels"] = voxels;
+  long long euler = 0;
+  std::uint64_t vertices = 0, triangles = 0;
+  for (const ComponentFigures& k : f.components) {
+    euler += k.euler;
+    vertices += k.surfels;
+    triangles += k.triangles;
+  }
+  py::dict d;
+  d["voxels"] = f.voxels;
+  d["components"] = componentsTable(f.components);
+  d["euler"] = euler;
+  d["vertices"] = vertices;
+  d["triangles"] = triangles;
+  d["levels"] = f.levels;
+  d["leaves"] = f.leaves;
   return d;
 }
 
@@ -855,6 +956,12 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("cli_precomputed_frame", &cliPrecomputedFrame);
   m.def("scan_label_block", &scanLabelBlockArray);
   m.def("merge_label_fragments", &mergeLabelFragmentsArrays);
+  m.def("scan_label_block_file", &scanLabelBlockFile);
+  m.def("fragment_file_summary", &fragmentFileSummary);
+  m.def("merge_label_files", &mergeLabelFilesArrays, py::arg("label"), py::arg("paths"), py::arg("spacing"),
+        py::arg("origin"), py::arg("direction"), py::arg("background"), py::arg("adjacency"), py::arg("figures"),
+        py::arg("path") = "", py::arg("binary") = true);
+  m.def("label_figures_by_tree", &labelFiguresByTreeArrays);
   m.def("scan_threshold_block", &scanThresholdBlockArray);
   m.def("merge_threshold_fragments", &mergeThresholdFragmentsArrays);
 }

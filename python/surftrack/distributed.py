@@ -13,7 +13,10 @@ The graph: one task per block (reads its box from the array — a zarr array, or
 as numpy is — and writes one fragment file; a block whose file exists is not computed again, so
 a stopped run resumes), one plan task, one task per shard of labels (reads its labels' fragments
 from the files, merges, writes or returns). Fragments go through the file system, never through
-the scheduler: ``work_dir`` must be shared by every worker.
+the scheduler: ``work_dir`` must be shared by every worker. A block's file is the engine's flat
+fragment file (core/include/surftrack/LabelBlockFiles.h), written and read in C++. A label whose
+fragments exceed ``merge_budget`` gets its exact figures from a tree of groups of blocks instead
+of a merged mesh (docs/theory.md, "A label larger than one merge").
 
 In Neuroglancer's formats (docs/python.md, "Neuroglancer output on Dask"), the reduce tasks
 encode each label with the single pass' C++ encoders (write_precomputed's), then, sharded, one
@@ -29,6 +32,7 @@ import tempfile
 import uuid
 import zlib
 from pathlib import Path
+from types import SimpleNamespace
 from typing import NamedTuple
 
 import numpy as np
@@ -50,11 +54,12 @@ def block_grid(shape, block):
     return [(tuple(a[0] for a in c), tuple(a[1] for a in c)) for c in itertools.product(*axes)]
 
 
-def _fragment_path(work_dir, lo, run):
+def _fragment_path(work_dir, lo, run, suffix=".frag"):
     """The fragment file of the block at `lo` in a run: `run` names what the fragments depend on
     (the kind of run, the array's shape and type, the block size, the selection, the pair), so
-    that a work_dir reused with other arguments recomputes rather than reuses."""
-    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}_{run}.npz"
+    that a work_dir reused with other arguments recomputes rather than reuses. Label maps' files
+    are the engine's fragment files (.frag); thresholds' are still numpy's .npz."""
+    return Path(work_dir) / f"block_{lo[0]}_{lo[1]}_{lo[2]}_{run}{suffix}"
 
 
 def _run_name(*what):
@@ -62,11 +67,9 @@ def _run_name(*what):
 
 
 def _summary(path):
-    """{label: (vertices, triangles)} of a fragment file."""
-    with np.load(path) as f:
-        labels = [int(s) for s in f["labels"]]
-        keys, tris = np.diff(f["key_offsets"]), np.diff(f["triangle_offsets"])
-    return {L: (int(k), int(t)) for L, k, t in zip(labels, keys, tris)}
+    """{label: (vertices, triangles)} of a fragment file (its index, checked: a damaged file is
+    a ValueError naming it)."""
+    return {L: (k, t) for L, k, t in _surftrack.fragment_file_summary(str(path))}
 
 
 def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir, run):
@@ -79,17 +82,11 @@ def _mesh_block(source, lo, hi, shape, background, adjacency, work_dir, run):
     box = np.ascontiguousarray(source[lo[0]:top[0], lo[1]:top[1], lo[2]:top[2]])
     if box.dtype.kind not in "biu":
         raise ValueError(f"a label image needs integer voxels, not {box.dtype}")
-    fragments = _surftrack.scan_label_block(box, list(lo), list(shape), list(lo), list(hi), background, adjacency)
-    labels = np.array([str(f[0]) for f in fragments])  # decimal text: uint64 and int64 ids exact
-    key_offsets = np.cumsum([0] + [len(f[2]) for f in fragments], dtype=np.int64)
-    triangle_offsets = np.cumsum([0] + [len(f[3]) for f in fragments], dtype=np.int64)
-    temporary = path.with_name(f".{path.name}.{uuid.uuid4().hex}.npz")
-    np.savez(temporary, labels=labels, voxels=np.array([f[1] for f in fragments], dtype=np.uint64),
-             key_offsets=key_offsets, triangle_offsets=triangle_offsets,
-             keys=np.concatenate([f[2] for f in fragments]) if fragments else np.zeros(0, np.uint64),
-             triangles=np.concatenate([f[3] for f in fragments]) if fragments else np.zeros((0, 3), np.uint32))
-    os.replace(temporary, path)
-    return str(path), {f[0]: (len(f[2]), len(f[3])) for f in fragments}
+    # Scanned and written in C++ (core/include/surftrack/LabelBlockFiles.h: a flat file, written
+    # under a temporary name and renamed, the same bytes on a retry).
+    counts = _surftrack.scan_label_block_file(box, list(lo), list(shape), list(lo), list(hi), background, adjacency,
+                                              str(path))
+    return str(path), {L: (k, t) for L, k, t in counts}
 
 
 #: Fragment bytes a reduce task holds at most (about): the plan makes more shards than asked
@@ -98,9 +95,9 @@ _SHARD_BYTES = 512 << 20
 
 
 def _plan(results, shards):
-    """Task: the labels cut into shards, each a list of (label, its blocks' files). Labels in the
-    order of their first block (neighbours together, so that a shard reads few files), cut into
-    runs of about equal fragment bytes: at least `shards` runs, and enough that none holds much
+    """Task: the labels cut into shards, each a list of (label, its blocks' files, its fragments'
+    bytes). Labels in the order of their first block (neighbours together, so that a shard reads
+    few files), cut into runs of about equal fragment bytes: at least `shards` runs, and enough that none holds much
     more than _SHARD_BYTES (a keys entry is 8 bytes, a triangle 12)."""
     where, weight = {}, {}
     for order, (path, summary) in enumerate(results):
@@ -112,7 +109,7 @@ def _plan(results, shards):
     count = max(1, min(len(labels), max(shards, -(-total // _SHARD_BYTES))))
     plan, run, filled = [], [], 0
     for label in labels:
-        run.append((label, [path for _, path in where[label]]))
+        run.append((label, [path for _, path in where[label]], weight[label]))
         filled += weight[label]
         if filled * count >= total * (len(plan) + 1) and len(plan) < count - 1:
             plan.append(run)
@@ -122,30 +119,37 @@ def _plan(results, shards):
     return plan
 
 
-def _shard_fragments(shard):
-    """(label, file) -> (voxels, keys, triangles) for every label of a shard, each file read
-    once (a label's fragments sliced out of it; the rest of the file dropped)."""
-    wanted = {}
-    for label, paths in shard:
-        for path in paths:
-            wanted.setdefault(path, set()).add(label)
-    out = {}
-    for path, labels in wanted.items():
-        with np.load(path) as f:
-            names = [int(s) for s in f["labels"]]
-            ko, to, voxels = f["key_offsets"], f["triangle_offsets"], f["voxels"]
-            keys, triangles = f["keys"], f["triangles"]
-            for i, label in enumerate(names):
-                if label in labels:
-                    out[label, path] = (int(voxels[i]), keys[ko[i]:ko[i + 1]].copy(),
-                                        triangles[to[i]:to[i + 1]].copy())
-    return out
-
-
-def _merge_label(label, fragments, geometry, background, adjacency, figures):
+def _merge_label(label, paths, geometry, background, adjacency, figures, out_path="", binary=True):
+    """A label's fragments read from its blocks' files and merged, all in C++ (no Python array
+    between the files and the mesh), and written to `out_path` when given (the bytes of
+    Surface.write, from the engine's arrays)."""
     spacing, origin, direction = geometry
-    return _surftrack.merge_label_fragments(label, fragments, spacing, origin, direction, background,
-                                            adjacency, figures)
+    return _surftrack.merge_label_files(label, list(paths), spacing, origin, direction, background, adjacency,
+                                        figures, out_path, binary)
+
+
+def _tree_figures(label, paths, geometry, adjacency, grid, budget):
+    """The figures of a label whose fragments exceed `budget` bytes, without its mesh: merged by
+    cells of blocks of at most `budget` bytes, combined up an octree (docs/theory.md, "A label
+    larger than one merge"); counts exact, area and volume summed in another order."""
+    spacing, origin, direction = geometry
+    shape, block = grid
+    f = _surftrack.label_figures_by_tree(label, list(paths), list(shape), list(block), spacing, origin, direction,
+                                         adjacency, int(budget))
+    boundaries, area, volume = _component_sums(f["components"])
+    return {"voxels": f["voxels"], "vertices": f["vertices"], "triangles": f["triangles"], "euler": f["euler"],
+            "boundaries": boundaries, "area": area, "volume": volume, "file": None, "levels": f["levels"]}
+
+
+def _component_sums(components):
+    """The number of components of a (K, 7) figures table (as Surface holds it) and their area
+    and volume, summed in the order the command line's table sums them."""
+    table = np.asarray(components).reshape(-1, 7)
+    area = volume = 0.0
+    for row in table:
+        area += float(row[5])
+        volume += float(row[6])
+    return len(table), area, volume
 
 
 def _file_name(label, naming):
@@ -157,35 +161,37 @@ def _file_name(label, naming):
     return f"{label}_{name.replace('/', '_').replace(' ', '_').replace(chr(92), '_')}.ply"
 
 
-def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None, encoding=None):
+def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None, encoding=None, budget=None,
+                  grid=None):
     """Task: every label of a shard merged; written into `out_dir` (named by _file_name) when it
     is given (the files only, returned as figures), else the surfaces' fields returned. With
-    `encoding` (_Encoding), each label encoded in Neuroglancer's format instead (_EncodedLabels)."""
-    from . import Surface
+    `encoding` (_Encoding), each label encoded in Neuroglancer's format instead (_EncodedLabels).
+    A label whose fragments exceed `budget` bytes gets its figures only (_tree_figures, "file"
+    None; write_label_meshes refuses a budget for Neuroglancer's formats)."""
     out = {}
-    fragments = _shard_fragments(shard)
     encoded = _EncodedLabels(encoding) if encoding else None
-    for label, paths in shard:
-        fields = _merge_label(label, [fragments.pop((label, p)) for p in paths], geometry, background,
-                              adjacency, figures)
+    for label, paths, weight in shard:
+        if budget is not None and weight > budget:
+            out[label] = _tree_figures(label, paths, geometry, adjacency, grid, budget)
+            continue
         if out_dir is None and encoding is None:  # plain arrays through the scheduler (the C++ result does not pickle)
+            fields = _merge_label(label, paths, geometry, background, adjacency, figures)
             result = fields.pop("result")
             fields["surfels"], fields["normals"] = result.surfels(), result.normals()
             out[label] = fields
             continue
-        surface = Surface(**fields)
         if encoding is not None:
-            file = encoded.add(label, surface)
+            fields = _merge_label(label, paths, geometry, background, adjacency, figures)
+            fields.pop("result", None)
+            file = encoded.add(label, SimpleNamespace(vertices=fields["vertices"], faces=fields["faces"]))
         else:
             file = _file_name(label, naming)
-            surface.write(str(Path(out_dir) / file), binary=naming["binary"] if naming else True)
-        area = volume = 0.0
-        for c in surface.components:  # summed in the order the command line's table sums them
-            area += c["area"]
-            volume += c["volume"]
-        out[label] = {"voxels": fields["voxels"], "vertices": len(surface.vertices),
-                      "triangles": len(surface.faces), "euler": fields["euler"],
-                      "boundaries": len(surface.components), "area": area, "volume": volume, "file": file}
+            fields = _merge_label(label, paths, geometry, background, adjacency, figures, str(Path(out_dir) / file),
+                                  naming["binary"] if naming else True)
+        boundaries, area, volume = _component_sums(fields["components"])
+        out[label] = {"voxels": fields["voxels"], "vertices": len(fields["vertices"]),
+                      "triangles": len(fields["faces"]), "euler": fields["euler"],
+                      "boundaries": boundaries, "area": area, "volume": volume, "file": file}
     if encoded is not None:
         return {"labels": out, "blobs": encoded.close()}
     return out
@@ -330,7 +336,7 @@ def _map_blocks(client, task, source, blocks, args, progress):
 
 
 def _run(source, *, block, spacing, origin, direction, background, adjacency, figures, client, workers,
-         work_dir, out_dir, shards, progress, naming=None, precomputed=None):
+         work_dir, out_dir, shards, progress, naming=None, precomputed=None, merge_budget=None):
     from dask.distributed import as_completed
     from . import _geometry
 
@@ -347,7 +353,7 @@ def _run(source, *, block, spacing, origin, direction, background, adjacency, fi
         shard_list = plan.result()
         encoding = None
         if precomputed is not None:
-            labels = sorted(L for s in shard_list for L, _ in s)
+            labels = sorted(L for s in shard_list for L, *_ in s)
             for L in labels:  # as the single pass' writer refuses them, before the merge
                 if L <= 0:
                     raise ValueError(f"segment id {L} cannot be written: Neuroglancer's segment ids are positive "
@@ -355,7 +361,7 @@ def _run(source, *, block, spacing, origin, direction, background, adjacency, fi
             encoding = _Encoding(precomputed["frame"], precomputed.get("cli_geometry"), len(labels),
                                  precomputed["staging"], work_dir, run)
         reduced = [client.submit(_reduce_shard, s, geometry, background, adjacency, figures, out_dir, naming,
-                                 encoding, pure=False) for s in shard_list]
+                                 encoding, merge_budget, (shape, tuple(block)), pure=False) for s in shard_list]
         out, merged, total, blobs = {}, 0, sum(len(s) for s in shard_list), {}
         for future in as_completed(reduced):
             part = future.result()
@@ -424,7 +430,8 @@ def label_surfaces(labels, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0), or
 def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0),
                        origin=(0.0, 0.0, 0.0), direction=None, background=0, adjacency="26-6", client=None,
                        workers=None, work_dir=None, shards=None, progress=None, format="ply", axes=None,
-                       unit="nm", names=None, lods=None, sharded=False, quantization_bits=16) -> dict:
+                       unit="nm", names=None, lods=None, sharded=False, quantization_bits=16,
+                       merge_budget=None) -> dict:
     """Every label's surface written into ``out_dir`` by the reduce tasks. ``format="ply"``: one
     file ``label_<L>.ply`` a label, each byte-identical to ``surftrack.label_surfaces(labels,
     ...)[L].write(...)`` on the whole array. ``format="precomputed"`` or
@@ -435,7 +442,16 @@ def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 
     format; ``axes`` required). ``out_dir`` (shared by the workers) must not exist or be empty;
     it appears whole at the end or not at all. Returns label -> figures (voxels, vertices,
     triangles, euler, boundaries, area, volume, file). ``progress`` stages: "blocks", "labels",
-    and "shards" for a sharded layout."""
+    and "shards" for a sharded layout. ``merge_budget`` (bytes, None: no limit; PLY only): a label
+    whose fragments take more is not merged whole: its figures are computed over a tree of groups
+    of blocks of at most that many bytes each (docs/theory.md, "A label larger than one merge";
+    counts exact, area and volume up to rounding), its mesh is not written ("file" None,
+    "levels" the tree's)."""
+    if merge_budget is not None and (isinstance(merge_budget, bool) or int(merge_budget) < 0):
+        raise ValueError(f"merge_budget must be a number of bytes (>= 0) or None, not {merge_budget!r}")
+    if merge_budget is not None and format != "ply":
+        raise ValueError("merge_budget is for format='ply': a label over the budget gets no mesh, and Neuroglancer's "
+                         "formats hold every label")
     target = Path(out_dir)
     precomputed = _precomputed_job(format, axes=axes, unit=unit, spacing=spacing, names=names, lods=lods,
                                    sharded=sharded, quantization_bits=quantization_bits)
@@ -450,7 +466,7 @@ def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 
             figures = _run(labels, block=block, spacing=spacing, origin=origin, direction=direction,
                            background=background, adjacency=adjacency, figures=True, client=client,
                            workers=workers, work_dir=work, out_dir=None if precomputed else str(staging),
-                           shards=shards, progress=progress, precomputed=precomputed)
+                           shards=shards, progress=progress, precomputed=precomputed, merge_budget=merge_budget)
         if precomputed is None:
             os.replace(staging, target)  # replaces an empty directory
     except BaseException:
@@ -484,8 +500,8 @@ def _precomputed_job(format, *, axes, unit, spacing, names, lods, sharded, quant
 
 def _threshold_block(source, lo, hi, shape, level, adjacency, mapping, epsilon, work_dir, run):
     """Task: the fragment of one block of a threshold's every boundary (docs/theory.md,
-    "Thresholds by blocks"), written to its file as _mesh_block writes its own."""
-    path = _fragment_path(work_dir, lo, run)
+    "Thresholds by blocks"), written to its file atomically as _mesh_block writes its own."""
+    path = _fragment_path(work_dir, lo, run, ".npz")
     if not path.exists():
         top = [min(h + 1, n) for h, n in zip(hi, shape)]  # the one-voxel apron on the high sides
         box = np.asarray(source[lo[0]:top[0], lo[1]:top[1], lo[2]:top[2]])

@@ -3,7 +3,8 @@ against surftrack.label_surfaces on the whole array (the single pass): the same 
 label and pair on random label images cut into blocks the shape does not divide (1-voxel-thick
 blocks and a single block included), byte-identical PLY files from a zarr store, uint64 ids
 around 2^53 and 2^64 - 1 exact, a resumed run that recomputes no finished block, a worker killed
-mid-run that changes nothing, and bad input refused before the run."""
+mid-run that changes nothing, bad input refused before the run, and labels over a merge budget
+given the single pass's figures by the tree of groups of blocks."""
 import os
 import zlib
 from pathlib import Path
@@ -167,6 +168,47 @@ def test_a_work_dir_reused_with_other_arguments_recomputes(client, tmp_path):
     other = blocks.label_surfaces(labels, block=(5, 5, 5), client=client, work_dir=work, background=int(IDS[1]))
     expect_same(other, surftrack.label_surfaces(labels, background=int(IDS[1])))
     assert len(list(work.iterdir())) == 2 * len(blocks.block_grid(labels.shape, (5, 5, 5)))
+
+
+def test_labels_over_the_merge_budget_get_exact_figures_from_the_tree(client, tmp_path):
+    """write_label_meshes with a merge_budget some labels exceed: those get no file and the single
+    pass's figures (counts exactly, area and volume within 1e-9 relative: summed by groups of
+    blocks, docs/theory.md "A label larger than one merge"); the others their byte-identical file."""
+    rng = np.random.default_rng(41)
+    shape = (23, 19, 21)
+    seeds = rng.integers(0, shape, size=(6, 3))
+    grid = np.stack(np.indices(shape), axis=-1).reshape(-1, 1, 3)
+    labels = np.argmin(((grid - seeds[None]) ** 2).sum(-1), axis=1).reshape(shape).astype(np.int32) - 2
+    labels[rng.random(shape) < 0.05] = 7  # specks: many components
+    want = surftrack.label_surfaces(labels, spacing=(2.0, 1.0, 0.5))
+    # A first run writes the fragment files, whose sizes set a budget half the labels exceed.
+    work = tmp_path / "work"
+    blocks.write_label_meshes(labels, tmp_path / "first", block=(4, 5, 3), client=client, work_dir=work)
+    weight = {}
+    for path in work.iterdir():
+        for label, keys, triangles in surftrack._surftrack.fragment_file_summary(str(path)):
+            weight[label] = weight.get(label, 0) + 8 * keys + 12 * triangles
+    sizes = sorted(weight.values())
+    budget = (sizes[len(sizes) // 2 - 1] + sizes[len(sizes) // 2]) // 2
+    figures = blocks.write_label_meshes(labels, tmp_path / "out", block=(4, 5, 3), spacing=(2.0, 1.0, 0.5),
+                                        client=client, work_dir=work, merge_budget=budget)
+    assert sorted(figures) == sorted(want)
+    by_tree = [L for L, f in figures.items() if f["file"] is None]
+    assert sorted(by_tree) == sorted(L for L in weight if weight[L] > budget) and 0 < len(by_tree) < len(want)
+    assert all(figures[L]["levels"] >= 1 for L in by_tree)
+    for label, w in want.items():
+        f = figures[label]
+        assert (f["voxels"], f["vertices"], f["triangles"], f["euler"], f["boundaries"]) == \
+            (w.voxels, len(w.vertices), len(w.faces), w.euler, len(w.components))
+        assert f["area"] == pytest.approx(sum(c["area"] for c in w.components), rel=1e-9)
+        assert f["volume"] == pytest.approx(sum(c["volume"] for c in w.components), rel=1e-9)
+        if f["file"] is None:
+            assert not (tmp_path / "out" / f"label_{label}.ply").exists()
+        else:
+            w.write(str(tmp_path / "want.ply"))
+            assert (tmp_path / "out" / f["file"]).read_bytes() == (tmp_path / "want.ply").read_bytes()
+    with pytest.raises(ValueError, match="merge_budget"):
+        blocks.write_label_meshes(labels, tmp_path / "bad", client=client, merge_budget=-1)
 
 
 THRESHOLD_CASES = [(np.float32, "linear"), (np.uint8, "midpoint"), (">f8", "linear"), (np.int16, "linear"),
