@@ -131,7 +131,8 @@ def test_bad_input_writes_nothing(client, tmp_path):
              ({"format": "precomputed"}, "axes"),
              ({"format": "precomputed-multires", "axes": "zyx", "lods": 11}, "lods"),
              ({"format": "precomputed-multires", "axes": "zyx", "quantization_bits": 12}, "quantization_bits"),
-             ({"format": "precomputed", "axes": "zyx", "unit": "furlong"}, "unit")]
+             ({"format": "precomputed", "axes": "zyx", "unit": "furlong"}, "unit"),
+             ({"format": "precomputed-multires", "axes": "zyx", "merge_budget": 1}, "merge_budget is for")]
     for options, says in cases:
         with pytest.raises(ValueError, match=says):
             blocks.write_label_meshes(labels, tmp_path / "out", client=client, **options)
