@@ -2,10 +2,11 @@
 Neuroglancer").
 
 Each case writes an output directory — the AAL atlas by the CLI (`surftrack labels aal.nii.gz -o
-DIR --format precomputed`), a Voronoi label volume by `surftrack.write_precomputed` — serves it
-over HTTP on 127.0.0.1 with CORS, as a user serves theirs, and opens it in Neuroglancer (the npm
-package, bundled by build_viewer.sh and served from another origin, as Neuroglancer's own site
-would be) in headless Chromium with software WebGL (open_viewer.mjs), with a state whose
+DIR --format precomputed`, and `--format precomputed-multires --lods 3`, unsharded and
+`--sharded`), a Voronoi label volume by `surftrack.write_precomputed` — serves it over HTTP on
+127.0.0.1 with CORS and byte ranges, as a user serves theirs, and opens it in Neuroglancer (the
+npm package, bundled by build_viewer.sh and served from another origin, as Neuroglancer's own
+site would be) in headless Chromium with software WebGL (open_viewer.mjs), with a state whose
 segmentation layer lists a few segments, each in a colour of its own, in the 3-D layout. It
 checks that:
   - the viewer gets ready (every chunk of every visible layer loaded and drawn);
@@ -13,13 +14,17 @@ checks that:
     that fails to decode is logged), no uncaught exception, no failed request, no error in the
     layer's messages or Neuroglancer's status box;
   - the data server was asked for every listed segment's manifest and each of its fragments
-    (and answered each), read from the files written;
+    (and answered each), read from the files written; in the multi-resolution format, a far
+    view asks for the byte ranges of every segment's coarsest level and none of the finer
+    levels', a near view for those of every level-0 fragment, the ranges read from the
+    manifests (and the shard index) by python/tests/multires_reader.py, written from the
+    format's description;
   - the picture shows each segment: the screenshot of the 3-D panel differs from the same state
     with no segment selected in more than 1 % of its pixels, and each segment's colour (its hue,
-    which the shading keeps) covers more than 0.2 % of them.
-A case lists one or more views (state changes, such as a zoom that makes Neuroglancer change
-levels of detail) and, for each, the requests it must cause (Case): the multi-resolution format
-is one more case.
+    which the shading keeps) covers more than 0.2 % of them, in every view.
+A case lists one or more views (state changes, such as a zoom and a meshRenderScale that make
+Neuroglancer change levels of detail) and, for each, the requests it must and must not cause
+(Case).
 
 Skipped, with the reason, when node, the bundle (build_viewer.sh), Chromium, the CLI or the AAL
 atlas (mricron-data) is missing. Run by ctest (python/CMakeLists.txt) after the bundle is built.
@@ -33,6 +38,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import threading
 import time
 import typing
@@ -40,6 +46,11 @@ import urllib.parse
 
 import numpy as np
 import pytest
+
+# The multi-resolution format's reader, written from the format's description (shared with
+# python/tests/test_precomputed_multires.py): which byte ranges hold which level of detail.
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "python", "tests"))
+import multires_reader  # noqa: E402
 
 BUNDLE = os.environ.get("SURFTRACK_NEUROGLANCER_BUNDLE", "")  # build_viewer.sh's OUT
 CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
@@ -147,13 +158,22 @@ class Server:
 
 # --- the outputs --------------------------------------------------------------------------------
 
-def write_aal(directory):
+def write_aal(directory, name="aal", options=("--format", "precomputed")):
     """The AAL atlas (116 regions on a 181 x 217 x 181 grid of 1 mm voxels), by the CLI."""
-    out = os.path.join(directory, "aal")
-    run = subprocess.run([EXE, "labels", AAL, "-o", out, "--format", "precomputed"],
-                         capture_output=True, text=True)
+    out = os.path.join(directory, name)
+    run = subprocess.run([EXE, "labels", AAL, "-o", out + "/", *options], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     return out
+
+
+LODS = 3
+
+
+def write_aal_multires(directory, sharded):
+    """The AAL atlas in the multi-resolution format, LODS levels of detail, by the CLI."""
+    return write_aal(directory, "aal-sharded" if sharded else "aal-multires",
+                     ("--format", "precomputed-multires", "--lods", str(LODS),
+                      *(["--sharded"] if sharded else [])))
 
 
 VORONOI = dict(n=96, cells=50, seed=20261203, spacing=(16.0, 8.0, 8.0))  # [z, y, x] nm
@@ -194,13 +214,14 @@ def voronoi_segments(count=6):
 
 
 def legacy_requests(out, segments, view):
-    """The legacy format's requests for `segments`: each manifest and the fragments it lists."""
+    """The legacy format's requests for `segments`: each manifest and the fragments it lists;
+    none refused."""
     paths = set()
     for s in segments:
         paths.add(f"{s}:0")
         with open(os.path.join(out, f"{s}:0")) as f:
             paths.update(json.load(f)["fragments"])
-    return paths
+    return paths, set()
 
 
 def legacy_vertices(out, segment):
@@ -215,20 +236,64 @@ def legacy_vertices(out, segment):
     return np.concatenate(parts)
 
 
+def multires_info(out):
+    with open(os.path.join(out, "info")) as f:
+        info = json.load(f)
+    assert info["@type"] == "neuroglancer_multilod_draco"
+    return info
+
+
+def multires_corners(out, segment):
+    """The corners (x, y, z nm) of the level-0 nodes of a multi-resolution segment, read from
+    its manifest: a box around its mesh, for the camera."""
+    info = multires_info(out)
+    if "sharding" in info:
+        manifest, _ = multires_reader.read_sharded(out, info, segment)
+    else:
+        with open(os.path.join(out, f"{segment}.index"), "rb") as f:
+            manifest = f.read()
+    m = multires_reader.parse_manifest(manifest)
+    low = m["origin"] + m["positions"][0] * m["chunk"]
+    corners = np.concatenate([low + np.array(c) * m["chunk"] for c in np.ndindex(2, 2, 2)])
+    t = np.asarray(info["transform"], float).reshape(3, 4)
+    return corners @ t[:, :3].T + t[:, 3]
+
+
+def multires_requests(out, segments, view):
+    """The multi-resolution format's requests for `segments` in `view`, whose "levels" names
+    the levels of detail it must fetch all the fragments of (the byte ranges the manifests
+    give), and whose "not_levels" those it must fetch none of: paths "file#bytes=first-last",
+    the data file or the shard file; and unsharded, each manifest "<id>.index"."""
+    info = multires_info(out)
+    wanted, refused = set(), set()
+    for s in segments:
+        if "sharding" not in info:
+            wanted.add(f"{s}.index")
+        for lod, level in enumerate(multires_reader.fragment_ranges(out, info, s)):
+            paths = {f"{name}#bytes={first}-{last}" for name, first, last in level}
+            if lod in view["levels"]:
+                wanted |= paths
+            if lod in view["not_levels"]:
+                refused |= paths
+    return wanted, refused
+
+
 @dataclasses.dataclass
 class Case:
     """One output opened in the viewer. `views` are the states it is seen in, each a dict of
     changes to the state made by `state()`: "zoom" divides the framing projectionScale (2: twice
-    as close), "layer" is merged into the layer, any other key replaces the state's. Each view
-    must cause the requests `requests` names, so a case for the multi-resolution format lists a
-    far view and a near one, with the fragments of the coarse and of the fine levels of detail
-    that each must fetch, and `vertices` reads its level 0 (or its legacy twin) for the framing."""
+    as close), "layer" is merged into the layer, "levels" and "not_levels" are for `requests`,
+    any other key replaces the state's. Each view must cause the requests `requests` names and
+    none of those it refuses, so a case for the multi-resolution format lists a far view and a
+    near one, with the fragments of the coarse and of the fine levels of detail that each must
+    (and must not) fetch, and `vertices` reads a box around level 0 (or the legacy vertices)
+    for the framing."""
     name: str
     write: typing.Callable  # (directory) -> the output directory
     segments: typing.Callable  # () -> segment ids
     vertices: typing.Callable = legacy_vertices  # (out, segment) -> (N, 3) nm, for the camera
-    # (out, segments, view) -> the paths under `out` the view must request ("path#bytes=a-b":
-    # that range of it)
+    # (out, segments, view) -> (the paths under `out` the view must request, those it must not)
+    # ("path#bytes=a-b": that range of it)
     requests: typing.Callable = legacy_requests
     views: list = dataclasses.field(default_factory=lambda: [{}])
 
@@ -237,9 +302,24 @@ class Case:
 # Precentral_L/R, Frontal_Sup_L/R, Parietal_Sup_L/R (aal.nii.txt).
 AAL_SEGMENTS = [1, 2, 3, 4, 59, 60]
 
+# Neuroglancer draws a node of level k > 0 of the multi-resolution format, rather than its
+# children, once its lod scale (2^k voxels, docs/cli.md) is at most the node's size of a pixel
+# times the layer's meshRenderScale (by default 1); the top level is always fetched. Framed
+# (zoom 1), a pixel of the AAL atlas is about 1/3 voxel: the near view needs level 0 (1/3 < 2,
+# lod scale of level 1); the far one, twice as far with meshRenderScale 32 (a pixel "worth"
+# about 20 voxels, over the 4 of the top level), needs the top level only.
+MULTIRES_VIEWS = [
+    {"zoom": 0.5, "layer": {"meshRenderScale": 32}, "levels": {LODS - 1}, "not_levels": set(range(LODS - 1))},
+    {"zoom": 1, "levels": {0}, "not_levels": set()},
+]
+
 CASES = [
     Case("aal", write_aal, lambda: AAL_SEGMENTS),
     Case("voronoi", write_voronoi, voronoi_segments),
+    Case("aal-multires", lambda d: write_aal_multires(d, sharded=False), lambda: AAL_SEGMENTS,
+         multires_corners, multires_requests, MULTIRES_VIEWS),
+    Case("aal-sharded", lambda d: write_aal_multires(d, sharded=True), lambda: AAL_SEGMENTS,
+         multires_corners, multires_requests, MULTIRES_VIEWS),
 ]
 
 
@@ -257,7 +337,7 @@ def state(source, segments, vertices, view):
     """A Neuroglancer state: one segmentation layer from `source` showing `segments` in the 3-D
     layout, the camera on their bounding box, seen from +z; nothing else drawn; then `view`'s
     changes (Case)."""
-    view = dict(view)
+    view = {k: v for k, v in view.items() if k not in ("levels", "not_levels")}
     zoom = view.pop("zoom", 1)
     layer = {
         "type": "segmentation",
@@ -361,8 +441,10 @@ def test_neuroglancer_shows_the_segments(case, tmp_path):
     background = pixels(jobs[0][1])
     for i, view in enumerate(case.views):
         asked = {p[len(name) + 2:] for p, _ in logs[i + 1] if p.startswith(f"/{name}/")}
-        wanted = case.requests(out, segments, view)
+        wanted, refused = case.requests(out, segments, view)
+        print(f"  view {i}: {len(asked)} requests, {len(wanted)} wanted, {len(refused)} refused")
         assert wanted <= asked, f"view {i}: not requested: {sorted(wanted - asked)}"
+        assert not refused & asked, f"view {i}: requested: {sorted(refused & asked)}"
         shot = pixels(jobs[i + 1][1])
         assert shot.shape == background.shape
         changed = float(np.mean(np.any(np.abs(shot - background) > 24, axis=2)))
