@@ -32,15 +32,12 @@ atlas (mricron-data) is missing. Run by ctest (python/CMakeLists.txt) after the 
 import colorsys
 import dataclasses
 import functools
-import http.server
 import json
 import os
 import re
 import shutil
 import subprocess
 import sys
-import threading
-import time
 import typing
 import urllib.parse
 
@@ -51,6 +48,7 @@ import pytest
 # python/tests/test_precomputed_multires.py): which byte ranges hold which level of detail.
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "python", "tests"))
 import multires_reader  # noqa: E402
+from serve import Server  # noqa: E402  (tests/browser/serve.py: CORS and byte ranges)
 
 BUNDLE = os.environ.get("SURFTRACK_NEUROGLANCER_BUNDLE", "")  # build_viewer.sh's OUT
 CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
@@ -74,86 +72,6 @@ def missing():
 
 
 pytestmark = pytest.mark.skipif(missing() is not None, reason=f"browser test SKIPPED: {missing()}")
-
-
-# --- HTTP ---------------------------------------------------------------------------------------
-
-class Handler(http.server.SimpleHTTPRequestHandler):
-    """Static files, with CORS (the viewer runs on another origin) and single byte ranges
-    (Neuroglancer reads parts of files in the multi-resolution format); records each request's
-    time, path and status, a ranged one also under "path#bytes=first-last"."""
-
-    def __init__(self, *args, log, **kwargs):
-        self.log = log
-        super().__init__(*args, **kwargs)
-
-    def end_headers(self):
-        self.send_header("Access-Control-Allow-Origin", "*")
-        self.send_header("Access-Control-Expose-Headers", "Content-Range, Content-Length")
-        self.send_header("Cache-Control", "no-store")
-        super().end_headers()
-
-    def send_head(self):
-        self.range_left = None
-        spec = self.headers.get("Range")
-        if spec is None or not spec.startswith("bytes=") or "," in spec:
-            return super().send_head()
-        path = self.translate_path(self.path)
-        if not os.path.isfile(path):
-            return super().send_head()
-        size = os.path.getsize(path)
-        first, _, last = spec[6:].partition("-")
-        if first == "":  # the last N bytes
-            first, last = max(0, size - int(last)), size - 1
-        else:
-            first, last = int(first), min(size - 1, int(last)) if last else size - 1
-        if first > last or first >= size:
-            self.send_error(416)
-            return None
-        f = open(path, "rb")
-        f.seek(first)
-        self.send_response(206)
-        self.send_header("Content-Type", self.guess_type(path))
-        self.send_header("Content-Range", f"bytes {first}-{last}/{size}")
-        self.send_header("Content-Length", str(last - first + 1))
-        self.end_headers()
-        self.range_left = last - first + 1
-        return f
-
-    def copyfile(self, source, outputfile):
-        if self.range_left is None:
-            return super().copyfile(source, outputfile)
-        outputfile.write(source.read(self.range_left))
-
-    def log_request(self, code="-", size="-"):
-        path = urllib.parse.unquote(urllib.parse.urlsplit(self.path).path)
-        now = time.time() * 1000
-        self.log.append((now, path, int(code)))
-        if self.headers.get("Range"):  # also as "path#bytes=first-last", for a Case to expect
-            self.log.append((now, f"{path}#{self.headers['Range']}", int(code)))
-
-    def log_message(self, *args):
-        pass
-
-
-class Server:
-    """A directory served on 127.0.0.1 (a free port) from a thread, while in a `with`."""
-
-    def __init__(self, directory):
-        self.log = []
-        handler = functools.partial(Handler, directory=str(directory), log=self.log)
-        self.httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
-        self.url = f"http://127.0.0.1:{self.httpd.server_address[1]}"
-
-    def __enter__(self):
-        self.thread = threading.Thread(target=self.httpd.serve_forever, daemon=True)
-        self.thread.start()
-        return self
-
-    def __exit__(self, *exc):
-        self.httpd.shutdown()
-        self.httpd.server_close()
-        self.thread.join()
 
 
 # --- the outputs --------------------------------------------------------------------------------
