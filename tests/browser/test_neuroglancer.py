@@ -2,8 +2,9 @@
 Neuroglancer").
 
 Each case writes an output directory — the AAL atlas by the CLI (`surftrack labels aal.nii.gz -o
-DIR --format precomputed`, and `--format precomputed-multires --lods 3`, unsharded and
-`--sharded`), a Voronoi label volume by `surftrack.write_precomputed` — serves it over HTTP on
+DIR --format precomputed`), a Voronoi label volume by `surftrack.write_precomputed`, and a
+smaller one by the CLI from a raw file in the multi-resolution format (`--format
+precomputed-multires --lods 3`, unsharded and `--sharded`) — serves it over HTTP on
 127.0.0.1 with CORS and byte ranges, as a user serves theirs, and opens it in Neuroglancer (the
 npm package, bundled by build_viewer.sh and served from another origin, as Neuroglancer's own
 site would be) in headless Chromium with software WebGL (open_viewer.mjs), with a state whose
@@ -76,34 +77,27 @@ pytestmark = pytest.mark.skipif(missing() is not None, reason=f"browser test SKI
 
 # --- the outputs --------------------------------------------------------------------------------
 
-def write_aal(directory, name="aal", options=("--format", "precomputed")):
+def write_aal(directory):
     """The AAL atlas (116 regions on a 181 x 217 x 181 grid of 1 mm voxels), by the CLI."""
-    out = os.path.join(directory, name)
-    run = subprocess.run([EXE, "labels", AAL, "-o", out + "/", *options], capture_output=True, text=True)
+    out = os.path.join(directory, "aal")
+    run = subprocess.run([EXE, "labels", AAL, "-o", out, "--format", "precomputed"],
+                         capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     return out
 
 
-LODS = 3
+# [z, y, x] nm. The legacy case's volume; the multi-resolution cases' is smaller, as their
+# writer's levels of detail take about 0.1 s per thousand voxels of a label (docs/cli.md).
+VORONOI = dict(n=96, cells=50, seed=20261203, spacing=(16.0, 8.0, 8.0))
+VORONOI_SMALL = dict(VORONOI, n=40, cells=20)
 
 
-def write_aal_multires(directory, sharded):
-    """The AAL atlas in the multi-resolution format, LODS levels of detail, by the CLI."""
-    return write_aal(directory, "aal-sharded" if sharded else "aal-multires",
-                     ("--format", "precomputed-multires", "--lods", str(LODS),
-                      *(["--sharded"] if sharded else [])))
-
-
-VORONOI = dict(n=96, cells=50, seed=20261203, spacing=(16.0, 8.0, 8.0))  # [z, y, x] nm
-
-
-@functools.lru_cache(maxsize=1)
-def voronoi_volume():
+@functools.lru_cache(maxsize=2)
+def voronoi_volume(n, cells, seed):
     """A Voronoi label volume indexed [z, y, x]: each voxel labelled 1 + its nearest centre's
     index (bench/bench_labels.py makes the large ones the same way), and the centres."""
     from scipy.spatial import cKDTree
-    n, cells = VORONOI["n"], VORONOI["cells"]
-    centres = np.random.default_rng(VORONOI["seed"]).random((cells, 3)) * n
+    centres = np.random.default_rng(seed).random((cells, 3)) * n
     grid = np.stack(np.meshgrid(*(np.arange(n),) * 3, indexing="ij"), axis=-1).reshape(-1, 3)
     _, nearest = cKDTree(centres).query(grid)
     return (nearest + 1).astype(np.uint32).reshape(n, n, n), centres
@@ -111,7 +105,7 @@ def voronoi_volume():
 
 def write_voronoi(directory):
     import surftrack
-    labels, _ = voronoi_volume()
+    labels, _ = voronoi_volume(VORONOI["n"], VORONOI["cells"], VORONOI["seed"])
     spacing = VORONOI["spacing"]
     surfaces = surftrack.label_surfaces(labels, spacing=spacing)
     out = os.path.join(directory, "voronoi")
@@ -119,16 +113,38 @@ def write_voronoi(directory):
     return out
 
 
-def voronoi_segments(count=6):
+def voronoi_segments(count=6, v=VORONOI):
     """Cells whose centres lie far apart across the x-y plane (farthest points, greedily), so
     that seen along z none hides another."""
-    _, centres = voronoi_volume()
+    _, centres = voronoi_volume(v["n"], v["cells"], v["seed"])
     xy = centres[:, [2, 1]]
-    chosen = [int(np.argmin(np.linalg.norm(xy - VORONOI["n"] / 2, axis=1)))]
+    chosen = [int(np.argmin(np.linalg.norm(xy - v["n"] / 2, axis=1)))]
     while len(chosen) < count:
         d = np.min(np.linalg.norm(xy[:, None] - xy[chosen][None], axis=2), axis=1)
         chosen.append(int(np.argmax(d)))
     return [c + 1 for c in chosen]
+
+
+LODS = 3
+
+
+def write_voronoi_multires(directory, sharded):
+    """The small Voronoi volume's shown cells (voronoi_segments) in the multi-resolution format,
+    LODS levels of detail, by the CLI from a raw file, unsharded or sharded."""
+    v = VORONOI_SMALL
+    labels, _ = voronoi_volume(v["n"], v["cells"], v["seed"])
+    raw = os.path.join(directory, "voronoi.raw")
+    labels.tofile(raw)  # x fastest
+    out = os.path.join(directory, "voronoi-sharded" if sharded else "voronoi-multires")
+    segments = ",".join(str(s) for s in voronoi_segments(v=v))
+    run = subprocess.run([EXE, "labels", raw, "--raw-dims", f"{v['n']},{v['n']},{v['n']}",
+                          "--raw-type", "uint32", "--spacing", ",".join(str(x) for x in v["spacing"][::-1]),
+                          "--unit", "nm", "--labels", segments, "--quiet", "-o", out + "/",
+                          "--format", "precomputed-multires", "--lods", str(LODS),
+                          *(["--sharded"] if sharded else [])], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    os.remove(raw)
+    return out
 
 
 def legacy_requests(out, segments, view):
@@ -221,23 +237,26 @@ class Case:
 AAL_SEGMENTS = [1, 2, 3, 4, 59, 60]
 
 # Neuroglancer draws a node of level k > 0 of the multi-resolution format, rather than its
-# children, once its lod scale (2^k voxels, docs/cli.md) is at most the node's size of a pixel
-# times the layer's meshRenderScale (by default 1); the top level is always fetched. Framed
-# (zoom 1), a pixel of the AAL atlas is about 1/3 voxel: the near view needs level 0 (1/3 < 2,
-# lod scale of level 1); the far one, twice as far with meshRenderScale 32 (a pixel "worth"
-# about 20 voxels, over the 4 of the top level), needs the top level only.
+# children, once its lod scale (2^k voxels, docs/cli.md) is at most the node's pixel size (in
+# voxels of the coarsest axis, at its nearest corner) times the layer's meshRenderScale (1 by
+# default); the top level is always fetched. The product is what a zoom changes, so the far view
+# is the framed camera with meshRenderScale 256, which Neuroglancer treats as a camera 256 times
+# farther, and keeps every segment large enough on screen for the picture's checks. Framed, a
+# pixel of the small Voronoi volume is about 1/11 voxel (1.3 x 40 x 16 nm over 600 pixels, per
+# 16 nm): the near view needs level 0 (1/11 < 2, the lod scale of level 1); the far one, a pixel
+# "worth" about 23 voxels (over the 4 of the top level), the top level only.
 MULTIRES_VIEWS = [
-    {"zoom": 0.5, "layer": {"meshRenderScale": 32}, "levels": {LODS - 1}, "not_levels": set(range(LODS - 1))},
-    {"zoom": 1, "levels": {0}, "not_levels": set()},
+    {"layer": {"meshRenderScale": 256}, "levels": {LODS - 1}, "not_levels": set(range(LODS - 1))},
+    {"levels": {0}, "not_levels": set()},
 ]
 
 CASES = [
     Case("aal", write_aal, lambda: AAL_SEGMENTS),
     Case("voronoi", write_voronoi, voronoi_segments),
-    Case("aal-multires", lambda d: write_aal_multires(d, sharded=False), lambda: AAL_SEGMENTS,
-         multires_corners, multires_requests, MULTIRES_VIEWS),
-    Case("aal-sharded", lambda d: write_aal_multires(d, sharded=True), lambda: AAL_SEGMENTS,
-         multires_corners, multires_requests, MULTIRES_VIEWS),
+    Case("voronoi-multires", lambda d: write_voronoi_multires(d, sharded=False),
+         lambda: voronoi_segments(v=VORONOI_SMALL), multires_corners, multires_requests, MULTIRES_VIEWS),
+    Case("voronoi-sharded", lambda d: write_voronoi_multires(d, sharded=True),
+         lambda: voronoi_segments(v=VORONOI_SMALL), multires_corners, multires_requests, MULTIRES_VIEWS),
 ]
 
 
