@@ -58,9 +58,12 @@ class Handler(http.server.SimpleHTTPRequestHandler):
         return f
 
     def copyfile(self, source, outputfile):
-        if self.range_left is None:
-            return super().copyfile(source, outputfile)
-        outputfile.write(source.read(self.range_left))
+        try:
+            if self.range_left is None:
+                return super().copyfile(source, outputfile)
+            outputfile.write(source.read(self.range_left))
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # a request the viewer cancelled (a level of detail it no longer wants)
 
     def log_request(self, code="-", size="-"):
         path = urllib.parse.unquote(urllib.parse.urlsplit(self.path).path)
