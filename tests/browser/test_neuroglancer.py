@@ -21,7 +21,7 @@ checks that:
     manifests (and the shard index) by python/tests/multires_reader.py, written from the
     format's description;
   - the picture shows each segment: the screenshot of the 3-D panel differs from a state with no
-    segment selected (taken once, by the first case run) in more than 1 % of its pixels, and
+    segment selected (taken once for all cases) in more than 1 % of its pixels, and
     each segment's colour (its hue, which the shading keeps) covers more than 0.2 % of them, in
     every view.
 A case lists one or more views (state changes, such as a zoom and a meshRenderScale that make
@@ -341,59 +341,77 @@ def hue_coverage(rgb, count):
     return out
 
 
-BACKGROUND = {}  # "none": the screenshot with no segment, once taken
+def check_page(name, result, log):
+    """The page got ready, with no error of any kind, every request answered."""
+    print(f"{name} ready in {result['seconds']} s on {result['renderer']}; {len(log)} requests")
+    for m in result["console"]:
+        print(f"  console {m['type']}: {m['text']}")
+    summary = {k: v for k, v in result.items() if k != "url"}
+    assert result["ready"], f"{name}: the viewer did not get ready: {summary}"
+    assert not result["pageErrors"], result["pageErrors"]
+    assert not result["failedRequests"], result["failedRequests"]
+    assert not result["statusErrors"], result["statusErrors"]
+    # console.error, and what Neuroglancer's workers log with console.log when a chunk fails to
+    # load or decode ("Error retrieving chunk ...")
+    errors = [m["text"] for m in result["console"]
+              if m["type"] == "error" or re.search(r"\berror\b", m["text"], re.I)]
+    assert not errors, f"{name}: console errors: {errors}"
+    assert all(status == 200 or status == 206 for _, status in log), log
+
+
+@pytest.fixture(scope="module")
+def opened(request, tmp_path_factory):
+    """Every selected case's output written, served and opened, all in one browser session (a
+    browser started per case cost about 4 s each): per case, its output and, per view, the
+    screenshot, the driver's result and the requests the data server logged while the page was
+    open (one page at a time); and under "none" the same for the state with no segment, the
+    panel's background, the same for every case."""
+    cases = [item.callspec.params["case"] for item in request.session.items
+             if hasattr(item, "callspec") and "case" in item.callspec.params]
+    tmp = tmp_path_factory.mktemp("browser")
+    data = tmp / "data"
+    data.mkdir()
+    outputs = {}
+    for case in cases:
+        out = case.write(data)
+        segments = case.segments()
+        vertices = np.concatenate([case.vertices(out, s) for s in segments])
+        outputs[case.name] = (out, os.path.relpath(out, data), segments, vertices)
+    with Server(os.path.join(BUNDLE, "dist")) as page, Server(data) as files:
+        jobs, owners = [], []
+        for case in cases:
+            out, name, segments, vertices = outputs[case.name]
+            source = f"precomputed://{files.url}/{name}"
+            if not jobs:
+                jobs.append((viewer_url(page.url, state(source, [], vertices, case.views[0])), tmp / "none.png"))
+                owners.append(("none", 0))
+            for i, view in enumerate(case.views):
+                jobs.append((viewer_url(page.url, state(source, segments, vertices, view)),
+                             tmp / f"{case.name}-view{i}.png"))
+                owners.append((case.name, i))
+        results = open_pages(jobs, tmp)
+        logs = [[(p, status) for t, p, status in files.log if r["startedAt"] <= t <= r["endedAt"]]
+                for r in results]
+    pages = {}
+    for (owner, i), (_, shot), result, log in zip(owners, jobs, results, logs):
+        pages.setdefault(owner, []).append((shot, result, log))
+    return {name: (outputs.get(name), views) for name, views in pages.items()}
 
 
 @pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
-def test_neuroglancer_shows_the_segments(case, tmp_path):
-    data = tmp_path / "data"
-    data.mkdir()
-    out = case.write(data)
-    segments = case.segments()
-    name = os.path.relpath(out, data)
-    vertices = np.concatenate([case.vertices(out, s) for s in segments])
-    with Server(os.path.join(BUNDLE, "dist")) as page, Server(data) as files:
-        source = f"precomputed://{files.url}/{name}"
-        # The picture with no segment: the panel's background, the same for every case, so
-        # taken by the first case run only.
-        jobs = []
-        if "none" not in BACKGROUND:
-            blank = state(source, [], vertices, case.views[0])
-            jobs.append((viewer_url(page.url, blank), tmp_path / "none.png"))
-        for i, view in enumerate(case.views):
-            jobs.append((viewer_url(page.url, state(source, segments, vertices, view)),
-                         tmp_path / f"view{i}.png"))
-        results = open_pages(jobs, tmp_path)
-        # Each page's requests: those the server logged while it was open (one at a time).
-        logs = [[(p, status) for t, p, status in files.log if r["startedAt"] <= t <= r["endedAt"]]
-                for r in results]
-    for (url, shot), result, log in zip(jobs, results, logs):
-        print(f"{case.name}: {shot.name} ready in {result['seconds']} s on {result['renderer']}; "
-              f"{len(log)} requests")
-        for m in result["console"]:
-            print(f"  console {m['type']}: {m['text']}")
-        summary = {k: v for k, v in result.items() if k != "url"}
-        assert result["ready"], f"{shot.name}: the viewer did not get ready: {summary}"
-        assert not result["pageErrors"], result["pageErrors"]
-        assert not result["failedRequests"], result["failedRequests"]
-        assert not result["statusErrors"], result["statusErrors"]
-        # console.error, and what Neuroglancer's workers log with console.log when a chunk
-        # fails to load or decode ("Error retrieving chunk ...")
-        errors = [m["text"] for m in result["console"]
-                  if m["type"] == "error" or re.search(r"\berror\b", m["text"], re.I)]
-        assert not errors, f"{shot.name}: console errors: {errors}"
-        assert all(status == 200 or status == 206 for _, status in log), log
-    if "none" not in BACKGROUND:
-        BACKGROUND["none"] = pixels(jobs[0][1])
-        jobs, logs = jobs[1:], logs[1:]
-    background = BACKGROUND["none"]
-    for i, view in enumerate(case.views):
-        asked = {p[len(name) + 2:] for p, _ in logs[i] if p.startswith(f"/{name}/")}
+def test_neuroglancer_shows_the_segments(case, opened):
+    (_, [(none, result, log)]) = opened["none"]
+    check_page("none.png", result, log)
+    background = pixels(none)
+    (out, name, segments, _), views = opened[case.name]
+    for i, (view, (shot, result, log)) in enumerate(zip(case.views, views)):
+        check_page(f"{case.name}: view {i}", result, log)
+        asked = {p[len(name) + 2:] for p, _ in log if p.startswith(f"/{name}/")}
         wanted, refused = case.requests(out, segments, view)
         print(f"  view {i}: {len(asked)} requests, {len(wanted)} wanted, {len(refused)} refused")
         assert wanted <= asked, f"view {i}: not requested: {sorted(wanted - asked)}"
         assert not refused & asked, f"view {i}: requested: {sorted(refused & asked)}"
-        shot = pixels(jobs[i][1])
+        shot = pixels(shot)
         assert shot.shape == background.shape
         changed = float(np.mean(np.any(np.abs(shot - background) > 24, axis=2)))
         coverage = hue_coverage(shot, len(segments))
