@@ -887,9 +887,9 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   }
   if (o.largest && !o.seeds.empty()) throw UsageError("give --largest or --seed, not both");
   parseDaskOptions(o.dask, a.block, o.workDir, o.block);
-  if (!o.dask.empty() && (o.largest || !o.seeds.empty() || !o.labels.empty() || o.range || !o.format.empty()))
-    throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest, "
-                     "--seed or --format yet");
+  if (!o.dask.empty() && (o.largest || !o.seeds.empty() || !o.labels.empty() || o.range))
+    throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest "
+                     "or --seed yet");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
   if (!o.unit.empty() && o.format.empty()) throw UsageError("--unit is for --format precomputed or precomputed-multires");
   checkPrecomputedOptions(app, o.format, o.output);

@@ -16,7 +16,9 @@
 #                   Test oracles that are not code under test are compiled without the
 #                   sanitizers (the CGAL checks, test_cli's harness; tests/CMakeLists.txt), and
 #                   io/ReadVolume.cpp, ITK's templates, without UBSan (io/CMakeLists.txt).
-#   all [seconds]   both.
+#   all [seconds]   both; the fuzzing, which runs one target at a time on one core, beside the
+#                   sanitized build (its log printed when both are done), then the sanitized
+#                   tests on a machine of their own. CI runs this (.ci/run).
 #
 #   scripts/ci-checks.sh fuzz|sanitize|all [seconds per fuzz target]
 #
@@ -39,8 +41,8 @@ child_cpu() {
   cpu=$(((f[15] + f[16]) / $(getconf CLK_TCK)))
 }
 
-sanitize() {
-  local start built cpu cpu0 cpu1
+sanitize_build() {
+  local start cpu cpu0
   start=$(date +%s)
   child_cpu
   cpu0=$cpu
@@ -50,10 +52,15 @@ sanitize() {
   cmake -S . -B build-sanitize -DSURFTRACK_SANITIZE=ON -DSURFTRACK_BUILD_BENCH=OFF \
         -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" >/dev/null
   cmake --build build-sanitize -j2 >build-sanitize.log 2>&1 || { tail -60 build-sanitize.log; exit 1; }
-  built=$(date +%s)
   child_cpu
-  cpu1=$cpu
-  echo "ci-checks: sanitized build in $((built - start)) s ($((cpu1 - cpu0)) CPU-s)"
+  echo "ci-checks: sanitized build in $(($(date +%s) - start)) s ($((cpu - cpu0)) CPU-s)"
+}
+
+sanitize_tests() {
+  local start cpu cpu0
+  start=$(date +%s)
+  child_cpu
+  cpu0=$cpu
   # Leaks inside third-party readers on their error paths are theirs (tests/lsan.supp names
   # each); every other leak, and every ASan or UBSan report, fails the test that caused it.
   # Exit code 86 for a report, so that a tool run by a test (test_cli) cannot pass a report
@@ -63,7 +70,7 @@ sanitize() {
   UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:exitcode=86" \
     ctest --test-dir build-sanitize --output-on-failure -j2
   child_cpu
-  echo "ci-checks: sanitized test suite in $(($(date +%s) - built)) s ($((cpu - cpu1)) CPU-s)"
+  echo "ci-checks: sanitized test suite in $(($(date +%s) - start)) s ($((cpu - cpu0)) CPU-s)"
 }
 
 fuzz() {
@@ -77,5 +84,18 @@ fuzz() {
   bash fuzz/run_fuzzers.sh "$seconds" "$here/build-fuzz"
 }
 
-[[ $mode == fuzz ]] || sanitize
-[[ $mode == sanitize ]] || fuzz
+case $mode in
+  fuzz) fuzz ;;
+  sanitize) sanitize_build; sanitize_tests ;;
+  all)
+    # The fuzzers run one at a time: on a 2-core machine their second core builds meanwhile.
+    fuzz >build-fuzz.ci.log 2>&1 &
+    fuzzing=$!
+    trap 'kill $fuzzing 2>/dev/null || true' EXIT  # a failed build stops the fuzzing too
+    sanitize_build
+    fuzz_status=0
+    wait $fuzzing || fuzz_status=$?
+    cat build-fuzz.ci.log
+    ((fuzz_status == 0)) || { echo "ci-checks: fuzzing failed (exit $fuzz_status)"; exit 1; }
+    sanitize_tests ;;
+esac
