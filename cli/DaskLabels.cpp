@@ -34,6 +34,7 @@ std::vector<LabelRow> labelRowsOnDask(const LabelsOptions& o, const LabelNames& 
     job["format"] = o.format;
     job["lods"] = o.format == "precomputed" ? 0 : o.precomputed.lods;
     job["sharded"] = o.precomputed.sharded;
+    job["shard_hash"] = o.precomputed.identityHash ? "identity" : "murmurhash3_x86_128";
     job["quantization_bits"] = o.precomputed.quantizationBits;
     job["nanometres"] = nanometresOf({o.unit, job["store_unit"].get<std::string>(), job["store_format"].get<std::string>()});
   }

@@ -355,7 +355,7 @@ void checkRaw(const InputOptions& in, const InputArgs& a) {
         "double)");
 }
 
-/// --lods, --sharded, --quantization-bits: the multi-resolution format's options.
+/// --lods, --sharded, --shard-hash, --quantization-bits: the multi-resolution format's options.
 void addPrecomputedOptions(CLI::App& app, PrecomputedOptions& p) {
   const std::string group = "Neuroglancer output";
   app.add_option("--lods", p.lods, "precomputed-multires: levels of detail, 1 to 10 (default 3); each a\n"
@@ -364,6 +364,15 @@ void addPrecomputedOptions(CLI::App& app, PrecomputedOptions& p) {
       ->check(CLI::Range(1, 10))
       ->group(group);
   app.add_flag("--sharded", p.sharded, "precomputed-multires: the sharded layout (a few .shard files)")->group(group);
+  addValue(
+      app, "--shard-hash", "H", [&p](const std::string& h) { p.identityHash = h == "identity"; },
+      "--sharded: the hash of ids to shards, murmurhash3_x86_128 (default) or\n"
+      "identity (consecutive ids share a minishard)")
+      ->check(explained(CLI::IsMember({"murmurhash3_x86_128", "identity"}),
+                        [](const std::string& s) {
+                          return "expected murmurhash3_x86_128 or identity, got '" + s + "'";
+                        }))
+      ->group(group);
   app.add_option("--quantization-bits", p.quantizationBits, "precomputed-multires: 10 or 16 (default 16)")
       ->option_text("B")
       ->check(CLI::IsMember({10, 16}))
@@ -373,9 +382,11 @@ void addPrecomputedOptions(CLI::App& app, PrecomputedOptions& p) {
 /// The options of the precomputed formats agree with --format and -o.
 void checkPrecomputedOptions(const CLI::App& app, const std::string& format, const std::string& output) {
   const bool multires = format == "precomputed-multires";
-  for (const char* name : {"--lods", "--sharded", "--quantization-bits"})
+  for (const char* name : {"--lods", "--sharded", "--shard-hash", "--quantization-bits"})
     if (app.get_option(name)->count() > 0 && !multires)
       throw UsageError(std::string(name) + " is for --format precomputed-multires");
+  if (app.get_option("--shard-hash")->count() > 0 && app.get_option("--sharded")->count() == 0)
+    throw UsageError("--shard-hash is for the sharded layout: add --sharded");
   if (!format.empty() && (output.find('{') != std::string::npos ||
                           (output.back() != '/' && !std::filesystem::path(output).extension().empty())))
     throw UsageError("--format " + format + " writes a directory: give -o DIR/, not '" + output + "'");

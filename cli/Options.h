@@ -75,6 +75,7 @@ struct OutputOptions {
 struct PrecomputedOptions {
   int lods = 3;             ///< --lods N: levels of detail
   bool sharded = false;     ///< --sharded
+  bool identityHash = false;  ///< --shard-hash identity (default murmurhash3_x86_128)
   int quantizationBits = 16;  ///< --quantization-bits 10|16
 };
 

@@ -56,6 +56,7 @@ void writePrecomputedOutput(const std::vector<OutputSegment>& segments, const st
   refine::MultiresolutionOptions o;
   o.lods = options.lods;
   o.sharded = options.sharded;
+  o.identityHash = options.identityHash;
   o.quantizationBits = options.quantizationBits;
   refine::writeMultiresolutionMeshes(out, directory, multiresFrame(g, k), o);
 }

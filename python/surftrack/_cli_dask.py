@@ -58,7 +58,7 @@ def _precomputed(job):
     lods = int(job["lods"])
     linear, offset = _surftrack.cli_precomputed_frame(*geometry, float(job["nanometres"]), lods > 0)
     frame = _Frame([list(r) for r in linear], list(offset), np.ones(3), lods, int(job["quantization_bits"]),
-                   1 if job["sharded"] else 0)
+                   (2 if job["shard_hash"] == "identity" else 1) if job["sharded"] else 0)
     return {"frame": frame, "cli_geometry": geometry, "staging": job["staging"], "target": None,
             "names": {int(L): n for L, n in job["names"].items()}}
 

@@ -6,6 +6,7 @@ format unsharded and sharded (one shard and many), on random label images of eve
 width (ids near 2^64 included) cut into blocks the shape does not divide; bad input refused
 before the run, and nothing left at the output path by an error."""
 import hashlib
+import json
 import os
 from pathlib import Path
 
@@ -177,9 +178,10 @@ def test_cli_labels_on_dask_writes_the_single_pass_directory(tmp_path):
                                       {"type": "scale", "scale": [2.0, 1.5, 1.0]}]}]}]
     names = tmp_path / "names.txt"
     names.write_text(f"{2**64 - 19} first\n{2**64 - 15} second one\n")
-    for fmt in [["precomputed", "--unit", "nm"],
-                ["precomputed-multires", "--lods", "2", "--sharded", "--frame", "ras", "--origin", "5,-3,2"]]:
-        single, dask = tmp_path / f"single-{fmt[0]}", tmp_path / f"dask-{fmt[0]}"
+    for i, fmt in enumerate([["precomputed", "--unit", "nm"],
+                             ["precomputed-multires", "--lods", "2", "--sharded", "--frame", "ras", "--origin", "5,-3,2"],
+                             ["precomputed-multires", "--lods", "1", "--sharded", "--shard-hash", "identity"]]):
+        single, dask = tmp_path / f"single-{i}", tmp_path / f"dask-{i}"
         common = ["--label-names", names, "--format", *fmt]
         a = run_cli("labels", store, "-o", f"{single}/", *common, "--table", tmp_path / "a.csv")
         assert a.returncode == 0, a.stderr
@@ -187,6 +189,8 @@ def test_cli_labels_on_dask_writes_the_single_pass_directory(tmp_path):
                     "--block", "10,6,8")
         assert b.returncode == 0, b.stderr
         assert tree(dask) == tree(single) and "info" in tree(single)
+        if "--shard-hash" in fmt:
+            assert json.loads((dask / "info").read_text())["sharding"]["hash"] == "identity"
         assert (tmp_path / "a.csv").read_text().replace(str(single), "D") == \
             (tmp_path / "b.csv").read_text().replace(str(dask), "D")
     r = run_cli("labels", store, "-o", f"{tmp_path}/bad/", "--format", "precomputed", "--lods", "2", "--dask", "local:2")

@@ -1,8 +1,8 @@
 """Neuroglancer's multi-resolution precomputed meshes (surftrack.write_precomputed(lods=N),
-`surftrack labels|mesh --format precomputed-multires`), read back by a reader written here from
-the format's description (neuroglancer's meshes.md and sharded.md: info, the binary .index
+`surftrack labels|mesh --format precomputed-multires`), read back by multires_reader.py, written
+from the format's description (neuroglancer's meshes.md and sharded.md: info, the binary .index
 manifest, fragments concatenated in manifest order, the shard index, gzip'd minishard indices,
-murmurhash3_x86_128) and every fragment decoded by Debian's `draco_decoder`, not by the writer's
+murmurhash3_x86_128), and every fragment decoded by Debian's `draco_decoder`, not by the writer's
 library calls. Checked against independent computations with numpy:
   - manifest sizes add up to the data; nodes in Z-order; every node's parent present;
   - every triangle of a level k > 0 fragment lies in the octant Neuroglancer's own rule (the
@@ -15,7 +15,6 @@ library calls. Checked against independent computations with numpy:
   - the transform puts level 0 where the legacy format puts the same mesh (nanometres);
   - sharded and unsharded layouts hold the same manifests and fragments;
   - bad input refused with one line and nothing written."""
-import gzip
 import json
 import os
 import shutil
@@ -28,6 +27,7 @@ from scipy.spatial import cKDTree
 
 import surftrack
 from conftest import closed_oriented_manifold
+from multires_reader import fragment_ranges, murmurhash3_x86_128_low64, parse_manifest, read_sharded, zorder
 
 CLI = os.environ.get("SURFTRACK_CLI")
 DRACO = shutil.which("draco_decoder")
@@ -36,41 +36,7 @@ NODE = shutil.which("node") if os.path.isdir(os.path.join(NODE_DIR, "node_module
 pytestmark = pytest.mark.skipif(DRACO is None, reason="draco_decoder (Debian package draco) not installed")
 
 
-# --- an independent reader of the format --------------------------------------------------------
-
-def murmurhash3_x86_128_low64(key):
-    """MurmurHash3_x86_128 (seed 0) of the 8 little-endian bytes of key: the low 64 bits."""
-    m = 0xFFFFFFFF
-
-    def rotl(x, r):
-        return ((x << r) | (x >> (32 - r))) & m
-
-    def fmix(h):
-        h ^= h >> 16
-        h = (h * 0x85EBCA6B) & m
-        h ^= h >> 13
-        h = (h * 0xC2B2AE35) & m
-        return h ^ (h >> 16)
-
-    data = struct.pack("<Q", key)
-    c1, c2, c3 = 0x239B961B, 0xAB0E9789, 0x38B34AE5
-    h = [0, 0, 0, 0]
-    k1 = int.from_bytes(data[0:4], "little")
-    k2 = int.from_bytes(data[4:8], "little")
-    k2 = (rotl((k2 * c2) & m, 16) * c3) & m
-    h[1] ^= k2
-    k1 = (rotl((k1 * c1) & m, 15) * c2) & m
-    h[0] ^= k1
-    h = [x ^ 8 for x in h]
-    h[0] = (h[0] + h[1] + h[2] + h[3]) & m
-    h[1] = (h[1] + h[0]) & m
-    h[2] = (h[2] + h[0]) & m
-    h[3] = (h[3] + h[0]) & m
-    h = [fmix(x) for x in h]
-    h[0] = (h[0] + h[1] + h[2] + h[3]) & m
-    h[1] = (h[1] + h[0]) & m
-    return h[0] | (h[1] << 32)
-
+# --- the format's reader (multires_reader.py) ----------------------------------------------------
 
 def test_murmurhash_against_a_reference_implementation():
     # MurmurHash3_x86_128 (h1 h2 h3 h4 in hex) of the 8 little-endian bytes of each key, as the
@@ -82,68 +48,6 @@ def test_murmurhash_against_a_reference_implementation():
                  2**53 + 1: "58396398dfde6c79dfa89e26dfa89e26"}
     for key, h in reference.items():
         assert murmurhash3_x86_128_low64(key) == int(h[0:8], 16) | (int(h[8:16], 16) << 32)
-
-
-def decode(data, encoding):
-    return gzip.decompress(data) if encoding == "gzip" else data
-
-
-def read_sharded(path, info, segid):
-    """(manifest bytes, fragment data bytes) of segid from the shard files."""
-    s = info["sharding"]
-    assert s["@type"] == "neuroglancer_uint64_sharded_v1"
-    key = segid >> s["preshift_bits"]
-    hashed = murmurhash3_x86_128_low64(key) if s["hash"] == "murmurhash3_x86_128" else key
-    assert s["hash"] in ("identity", "murmurhash3_x86_128")
-    minishard = hashed & ((1 << s["minishard_bits"]) - 1)
-    shard = (hashed >> s["minishard_bits"]) & ((1 << s["shard_bits"]) - 1)
-    width = max(1, -(-s["shard_bits"] // 4))
-    data = open(os.path.join(path, f"{shard:0{width}x}.shard"), "rb").read()
-    index_end = 16 << s["minishard_bits"]
-    start, end = struct.unpack_from("<QQ", data, 16 * minishard)
-    assert index_end + end <= len(data)
-    index = np.frombuffer(decode(data[index_end + start:index_end + end], s["minishard_index_encoding"]), "<u8")
-    assert len(index) % 3 == 0
-    ids, starts, sizes = index.reshape(3, -1).astype(object)
-    ids = np.cumsum(ids)
-    position = index_end
-    for i, chunk in enumerate(ids):
-        position += starts[i]
-        if chunk == segid:
-            manifest = decode(data[position:position + sizes[i]], s["data_encoding"])
-            total = sum(parse_manifest(manifest)["sizes"])
-            assert total <= position
-            return manifest, data[position - total:position]
-        position += sizes[i]
-    raise KeyError(segid)
-
-
-def parse_manifest(m):
-    """The fields of a manifest, its length checked against them."""
-    chunk = np.frombuffer(m, "<f4", 3, 0)
-    origin = np.frombuffer(m, "<f4", 3, 12)
-    (lods,) = struct.unpack_from("<I", m, 24)
-    scales = np.frombuffer(m, "<f4", lods, 28)
-    offsets = np.frombuffer(m, "<f4", 3 * lods, 28 + 4 * lods).reshape(lods, 3)
-    counts = np.frombuffer(m, "<u4", lods, 28 + 16 * lods)
-    at = 28 + 20 * lods
-    positions, sizes = [], []
-    for n in counts:
-        positions.append(np.frombuffer(m, "<u4", 3 * n, at).reshape(3, n).T.astype(np.int64))
-        at += 12 * n
-        sizes.extend(np.frombuffer(m, "<u4", n, at).tolist())
-        at += 4 * n
-    assert at == len(m), "the manifest's length does not match its fields"
-    return dict(chunk=chunk.astype(float), origin=origin.astype(float), lods=lods, scales=scales,
-                vertex_offsets=offsets, positions=positions, sizes=sizes)
-
-
-def zorder(p):
-    key = 0
-    for bit in range(21):
-        for axis in range(3):
-            key |= ((int(p[axis]) >> bit) & 1) << (3 * bit + axis)
-    return key
 
 
 def draco_decode(data, tmp):
@@ -475,6 +379,14 @@ def test_sharded_and_unsharded_hold_the_same_segments(tmp_path):
             manifest, data = read_sharded(str(out), info, segid)
             assert manifest == (tmp_path / "u" / f"{segid}.index").read_bytes()
             assert data == (tmp_path / "u" / str(segid)).read_bytes()
+            # The byte ranges the browser test expects Neuroglancer to request: the same
+            # fragments in the shard file as in the unsharded data file.
+            sharded_ranges = fragment_ranges(str(out), info, segid)
+            plain_ranges = fragment_ranges(str(tmp_path / "u"), read_info(tmp_path / "u"), segid)
+            assert [len(level) for level in sharded_ranges] == [len(level) for level in plain_ranges]
+            for (name, a, b), (plain, c, d) in zip(sum(sharded_ranges, []), sum(plain_ranges, [])):
+                assert plain == str(segid) and b - a == d - c
+                assert (out / name).read_bytes()[a:b + 1] == (tmp_path / "u" / plain).read_bytes()[c:d + 1]
     with pytest.raises(ValueError, match="sharded"):
         surftrack.write_precomputed(surfaces, tmp_path / "x", axes="zyx", lods=2, sharded="md5")
 
@@ -531,12 +443,15 @@ def test_cli_labels_and_mesh(tmp_path):
     raw = tmp_path / "seg.raw"
     labels.astype(np.uint64).tofile(raw)
     base = ["--raw-dims", "18,16,14", "--raw-type", "uint64", "--spacing", "4,5,40", "--unit", "nm", "--quiet"]
-    for extra in ([], ["--sharded"]):
+    for extra in ([], ["--sharded"], ["--sharded", "--shard-hash", "identity"],
+                  ["--sharded", "--shard-hash", "murmurhash3_x86_128"]):
         out = tmp_path / ("cli" + "".join(extra))
         run = subprocess.run([CLI, "labels", str(raw), *base, "--format", "precomputed-multires", "--lods", "2",
                               *extra, "-o", str(out) + "/"], capture_output=True, text=True)
         assert run.returncode == 0, run.stderr
         info = read_info(out)
+        hashing = extra[2] if len(extra) > 2 else "murmurhash3_x86_128"
+        assert info.get("sharding", {}).get("hash", hashing) == hashing and ("sharding" in info) == bool(extra)
         t = np.asarray(info["transform"]).reshape(3, 4)
         # Voxel indices to nanometres: the spacing, and half a voxel (voxel i over [i, i + 1)).
         assert np.allclose(t[:, :3], np.diag([4, 5, 40])) and np.allclose(t[:, 3], [2, 2.5, 20])
@@ -550,6 +465,14 @@ def test_cli_labels_and_mesh(tmp_path):
     assert run.returncode == 0, run.stderr
     info = read_info(out)
     assert sorted(os.listdir(out)) == ["12", "12.index", "info"]
+    run = subprocess.run([CLI, "mesh", str(raw), *base, "--label", "4", "--format", "precomputed-multires",
+                          "--id", "12", "--sharded", "--shard-hash", "identity", "-o", str(tmp_path / "one-s") + "/"],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    info = read_info(tmp_path / "one-s")
+    assert info["sharding"]["hash"] == "identity"
+    manifest, data = read_sharded(str(tmp_path / "one-s"), info, 12)
+    assert manifest == (out / "12.index").read_bytes() and data == (out / "12").read_bytes()
     run = subprocess.run([CLI, "mesh", str(raw), *base, "--label", "4", "--format", "precomputed",
                           "-o", str(tmp_path / "legacy") + "/"], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
@@ -567,3 +490,9 @@ def test_cli_labels_and_mesh(tmp_path):
              "-o", str(tmp_path / "z") + "/"], "--lods")
     refused(["labels", str(raw), *base, "--lods", "2", "-o", str(tmp_path / "z") + "/"], "precomputed-multires")
     refused(["labels", str(raw), *base, "--format", "precomputed-multires", "-o", str(raw)], "directory")
+    refused(["labels", str(raw), *base, "--format", "precomputed-multires", "--shard-hash", "identity",
+             "-o", str(tmp_path / "z") + "/"], "--sharded")
+    refused(["mesh", str(raw), *base, "--label", "4", "--format", "precomputed", "--shard-hash", "identity",
+             "-o", str(tmp_path / "z") + "/"], "precomputed-multires")
+    refused(["labels", str(raw), *base, "--format", "precomputed-multires", "--sharded", "--shard-hash", "md5",
+             "-o", str(tmp_path / "z") + "/"], "murmurhash3_x86_128 or identity")

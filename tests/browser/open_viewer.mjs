@@ -4,7 +4,7 @@
 // and drawn every visible layer's chunks: viewer.isReady() true on every poll over `settle` ms.
 // Then it saves a screenshot of the 3-D panel. It prints one JSON list, one entry per URL:
 // whether the viewer got ready, the time it took, the console messages, uncaught page errors,
-// failed requests, Neuroglancer's own error messages (layers' and the status box's) and the
+// failed requests (and those the viewer cancelled), Neuroglancer's own error messages (layers' and the status box's) and the
 // WebGL renderer, and when the page was opened and closed. tests/browser/test_neuroglancer.py writes the list of jobs and reads the
 // answer.
 //
@@ -52,13 +52,19 @@ async function open({ url, screenshot }) {
     console: [],
     pageErrors: [],
     failedRequests: [],
+    abortedRequests: [],
     statusErrors: [],
     renderer: null,
   };
   const page = await browser.newPage({ viewport: { width: 800, height: 600 } });
   page.on("console", (m) => result.console.push({ type: m.type(), text: m.text() }));
   page.on("pageerror", (e) => result.pageErrors.push(String(e)));
-  page.on("requestfailed", (r) => result.failedRequests.push(`${r.url()}: ${r.failure()?.errorText}`));
+  // A request Neuroglancer cancels itself (a fragment of a level of detail it no longer wants,
+  // as the panel takes its size) fails with net::ERR_ABORTED: listed apart, not a failure.
+  page.on("requestfailed", (r) => {
+    const error = r.failure()?.errorText;
+    (error === "net::ERR_ABORTED" ? result.abortedRequests : result.failedRequests).push(`${r.url()}: ${error}`);
+  });
   page.on("response", (r) => {
     if (r.status() >= 400) result.failedRequests.push(`${r.url()}: HTTP ${r.status()}`);
   });
