@@ -52,7 +52,7 @@ def timed_once(fn):
 
 def level_bytes(out: Path, labels) -> list[int]:
     """The bytes of each level of detail over every label, from the .index manifests."""
-    from test_precomputed_multires import parse_manifest
+    from multires_reader import parse_manifest
     per_level = None
     for label in labels:
         m = parse_manifest((out / f"{label}.index").read_bytes())
