@@ -175,6 +175,16 @@ void checkImage(const std::vector<std::uint16_t>& data, Dims dims, bool withBack
     if (withBackground && x == 0) return 0;
     return int(std::lower_bound(values.begin(), values.end(), x) - values.begin()) + 1;
   };
+  // No wall lies in a face plane of its cube (docs/theory.md §12, "Smoothing the complex": the
+  // two cubes of a face then see the same trace segments on it): in doubled coordinates the
+  // face planes are the even ones, where a vertex's own axis is odd.
+  for (const LabelSurface& l : before)
+    for (const auto& t : l.surface.triangles)
+      for (int axis = 0; axis < 3; ++axis) {
+        std::array<long long, 3> k;
+        for (int j = 0; j < 3; ++j) k[std::size_t(j)] = std::llround(2 * l.surface.vertices[t[std::size_t(j)]][std::size_t(axis)]);
+        ASSERT_FALSE(k[0] == k[1] && k[1] == k[2] && k[0] % 2 == 0) << what << ": a wall in a cube's face plane";
+      }
   const Counts a = checkComplex(before, dims, withBackground, priorityOf, 0.5, rng, what + " before");
   const Counts b = checkComplex(after, dims, withBackground, priorityOf, smooth.epsilon, rng, what + " after");
   EXPECT_EQ(a.twins, b.twins) << what;
