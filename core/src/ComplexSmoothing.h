@@ -12,6 +12,7 @@
 #include "ConstrainedSmoothing.h"
 #include "Errors.h"
 #include "Refine.h"
+#include "SmoothingParameters.h"
 
 namespace surftrack {
 
@@ -22,16 +23,7 @@ inline SmoothReport smoothComplex(std::vector<refine::Point3>& points, const std
                                   const std::vector<std::array<std::uint32_t, 3>>& triangles,
                                   const ImageGeometry& geometry, const SmoothOptions& o,
                                   const std::atomic<bool>* extractionCancel) {
-  if (o.iterations > kMaxSmoothIterations)
-    throw InvalidInput("smoothing iterations " + std::to_string(o.iterations) + " is above the limit of " +
-                       std::to_string(kMaxSmoothIterations));
-  refine::SmoothingParameters p;
-  p.iterations = o.iterations;
-  p.lambda = o.lambda;
-  p.mu = o.mu;
-  p.epsilon = o.epsilon;
-  p.threads = o.threads;
-  p.cancel = o.cancel ? o.cancel : extractionCancel;
+  const refine::SmoothingParameters p = smoothingParameters(o, extractionCancel);
   refine::SmoothingReport r;
   // As smooth(): a bad argument is the caller's, a broken invariant the engine's (the order of
   // the handlers matters: std::invalid_argument is a std::logic_error).

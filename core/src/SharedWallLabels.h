@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "BoundaryMapping.h"
@@ -82,37 +83,36 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     std::vector<Surfel> surfels;
     std::vector<std::array<std::uint32_t, 3>> triangles;
   } complex;
-  auto complexVertex = [&](const Voxel& m, int edge) {
+  // The vertex of cube m's edge in a vertex map keyed by grid edge, and whether it is new; a new
+  // one gets its surfel from its low voxel where fromLow(priority low, priority high) says so,
+  // else from its high voxel.
+  auto vertexOfEdge = [&](std::unordered_map<std::uint64_t, std::uint32_t>& vertexOf, std::vector<Surfel>& surfels,
+                          const Voxel& m, int edge, auto&& fromLow) {
     const Voxel lo = m + cube::cornerOffset(cube::edgeLowCorner(edge));
+    const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
     const int axis = cube::edgeAxis(edge);
-    const std::uint64_t key = Surfel{lo, directionOf(axis, +1)}.key();
-    const auto [it, added] = complex.vertexOf.try_emplace(key, std::uint32_t(complex.surfels.size()));
-    if (added) {
-      const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
-      complex.surfels.push_back(priorityAt(lo) > priorityAt(hi) ? Surfel{lo, directionOf(axis, +1)}
+    const auto [it, added] = vertexOf.try_emplace(Surfel{lo, directionOf(axis, +1)}.key(), std::uint32_t(surfels.size()));
+    if (added)
+      surfels.push_back(fromLow(priorityAt(lo), priorityAt(hi)) ? Surfel{lo, directionOf(axis, +1)}
                                                                 : Surfel{hi, directionOf(axis, -1)});
-    }
-    return it->second;
+    return std::pair<std::uint32_t, bool>{it->second, added};
+  };
+  auto complexVertex = [&](const Voxel& m, int edge) {
+    return vertexOfEdge(complex.vertexOf, complex.surfels, m, edge,
+                        [](std::uint32_t pl, std::uint32_t ph) { return pl > ph; }).first;
   };
   std::vector<int> slot(labels.size() + 1, -1);  // priority -> index into building, -1 if not selected
   std::vector<Building> building(selected.size());
   for (std::size_t k = 0; k < selected.size(); ++k) slot[selected[k] + 1] = int(k);
   std::unordered_map<std::uint32_t, CubeWalls> cache;  // by the corners' local ranks, 3 bits each
   auto vertex = [&](Building& b, std::uint32_t label, const Voxel& m, int edge) {
-    const Voxel lo = m + cube::cornerOffset(cube::edgeLowCorner(edge));
-    const int axis = cube::edgeAxis(edge);
-    const std::uint64_t key = Surfel{lo, directionOf(axis, +1)}.key();
-    const auto [it, added] = b.vertexOf.try_emplace(key, std::uint32_t(b.surfels.size()));
-    if (added) {
-      // The label's own surfel has its voxel inside; a vertex of two other labels (a junction)
-      // is oriented from the one of higher priority.
-      const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
-      const std::uint32_t pl = priorityAt(lo), ph = priorityAt(hi);
-      const bool fromLow = pl == label || (ph != label && pl > ph);
-      b.surfels.push_back(fromLow ? Surfel{lo, directionOf(axis, +1)} : Surfel{hi, directionOf(axis, -1)});
-      if (smoothing) b.complexVertex.push_back(complexVertex(m, edge));
-    }
-    return it->second;
+    // The label's own surfel has its voxel inside; a vertex of two other labels (a junction) is
+    // oriented from the one of higher priority.
+    const auto [v, added] = vertexOfEdge(b.vertexOf, b.surfels, m, edge, [&](std::uint32_t pl, std::uint32_t ph) {
+      return pl == label || (ph != label && pl > ph);
+    });
+    if (added && smoothing) b.complexVertex.push_back(complexVertex(m, edge));
+    return v;
   };
   for (int z = -1; z < dims.nz; ++z)
     for (int y = -1; y < dims.ny; ++y)

@@ -6,25 +6,18 @@ segment; every voxel centre is inside its own label's mesh only and random point
 one label, by solid angles; the refusals."""
 import json
 import subprocess
-import warnings
 
 import numpy as np
 import pytest
 
 import surftrack
-from test_shared_walls import cli, directed_triangles, reverse, winding_numbers
+from test_shared_walls import cli, directed_triangles, reverse, shared, winding_numbers
 
 
 def volume(surface):
     """The signed volume the mesh encloses (divergence theorem), by numpy."""
     v = surface.vertices[surface.faces.astype(np.int64)]
     return float(np.einsum("fi,fi->f", v[:, 0], np.cross(v[:, 1], v[:, 2])).sum() / 6)
-
-
-def shared(labels, **kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # pinch copies are announced as warnings
-        return surftrack.label_surfaces(labels, walls="shared", threads=1, **kwargs)
 
 
 def test_smoothed_walls_stay_shared_and_space_stays_partitioned(rng):
