@@ -303,6 +303,48 @@ TEST(ComplexSmoothing, BinarySphere) {
   EXPECT_LT(gap, 1e-9);
 }
 
+TEST(ComplexSmoothing, MirroredAnisotropicGeometry) {
+  // Smoothing in physical space under a mirrored, anisotropic frame: one point per grid edge in
+  // every label, each on its segment (through the inverse geometry), normals still outwards.
+  std::mt19937_64 rng(99);
+  ImageGeometry g;
+  g.spacing = {0.8, 1.3, 1.1};
+  g.origin = {2.0, -1.0, 0.5};
+  g.direction = {{{1, 0, 0}, {0, -1, 0}, {0, 0, 1}}};
+  ASSERT_LT(g.handedness(), 0);
+  for (int image = 0; image < 30; ++image) {
+    const Dims dims{4, 3, 5};
+    const std::vector<std::uint16_t> data = testing::randomLabels(rng, dims, 2 + image % 9, true);
+    if (!caseChecked(std::uint64_t(image))) continue;
+    LabelOptions options;
+    options.walls = LabelWalls::Shared;
+    options.threads = 1;
+    options.smooth = SmoothOptions{};
+    const std::vector<LabelSurface> surfaces = extractLabels(VolumeView::of(data.data(), dims, g), options);
+    std::map<std::array<int, 4>, Bits> pointOf;
+    for (const LabelSurface& l : surfaces) {
+      const Surface& s = l.surface;
+      EXPECT_GT(l.smooth->volumeAfter, 0) << "image " << image;
+      EXPECT_GT(l.smooth->volumeBefore, 0) << "image " << image;
+      TriangleMesh mesh;
+      mesh.triangles = s.triangles;
+      EXPECT_NEAR(testing::signedVolume(mesh, s.vertices), l.smooth->volumeAfter, 1e-9 * l.smooth->volumeAfter);
+      for (std::size_t v = 0; v < s.vertices.size(); ++v) {
+        const auto [it, added] = pointOf.try_emplace(gridEdge(s.surfels[v]), bitsOf(s.vertices[v]));
+        EXPECT_EQ(it->second, bitsOf(s.vertices[v])) << "image " << image << ": a grid edge at two points";
+        const P3 q = g.toIndex(s.vertices[v]);
+        const Voxel c = s.surfels[v].inside(), d = s.surfels[v].outside();
+        const int axis = gridEdge(s.surfels[v])[3];
+        for (int a = 0; a < 3; ++a)
+          if (a != axis) EXPECT_NEAR(q[std::size_t(a)], double(c[a]), 1e-9) << "image " << image;
+        const double t = (q[std::size_t(axis)] - c[axis]) / double(d[axis] - c[axis]);
+        EXPECT_GE(t, 1e-3 - 1e-9) << "image " << image;
+        EXPECT_LE(t, 1 - 1e-3 + 1e-9) << "image " << image;
+      }
+    }
+  }
+}
+
 TEST(ComplexSmoothing, Refusals) {
   const std::vector<std::uint8_t> data{1, 2, 0, 1, 2, 2, 0, 1};
   const VolumeView view = VolumeView::of(data.data(), {2, 2, 2});
