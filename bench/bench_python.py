@@ -15,7 +15,7 @@ Inputs (all made or loaded once, before any timing):
     vtkFlyingEdges3D (wrapping the array with numpy_to_vtk(deep=0), Update(), the output's
     points and triangles viewed as numpy arrays), VTK on one thread (SMP backend "Sequential").
     surftrack runs with its default thread count (extract's threads=0: all cores) and again on
-    one thread (threads=1 added to the extract() call marching_cubes makes). On the spheres of
+    one thread (its threads=1). On the spheres of
     q >= 512 scikit-image runs once only if its first run takes longer than --skimage-slow.
 (b) surftrack.extract(volume, level=..., seed=<the protocol's seed surfel>) (mode="largest" on
     the MRI, as the CLI demo): Python wall time against the sum of Surface.timings, the stage
@@ -299,9 +299,8 @@ def main(argv=None) -> int:
     parser.add_argument("--no-one-thread", action="store_true",
                         help="time surftrack.marching_cubes with its default threads only, not also with threads=1")
     parser.add_argument("--breakdown", action="store_true",
-                        help="after the timed runs, split one more surftrack.marching_cubes call into its "
-                             "extract() call (core stages, the rest), normals, surfels and the rest (not in "
-                             "the medians)")
+                        help="split surftrack.marching_cubes' time into its binding's call (the core's "
+                             "stages, the four arrays) and the rest (Python: range check, arguments)")
     args = parser.parse_args(argv)
 
     sizes = [int(s) for s in args.sizes.split(",") if s]
@@ -355,33 +354,32 @@ def main(argv=None) -> int:
                          runs_s=" ".join(f"{t:.4f}" for t in times)))
         return statistics.median(times)
 
-    # surftrack.marching_cubes calls surftrack.extract(); a one-call wrapper records the core's
-    # stage times of each call and, for the one-thread runs, adds threads=1 to it (the
-    # marching_cubes signature has no threads argument; extract's default is all cores).
-    has_threads = "threads" in inspect.signature(surftrack.extract).parameters
+    # surftrack.marching_cubes calls its binding's marching_cubes_array once, whose last result
+    # is the stage times (the core's, then "arrays": the four arrays written); a one-call wrapper
+    # records them. The one-thread runs pass threads=1 to marching_cubes.
+    binding = surftrack._surftrack
+    has_threads = "threads" in inspect.signature(surftrack.marching_cubes).parameters
     st_variants = [("default", {})]
     if has_threads and not args.no_one_thread:
         st_variants.append(("1 thread", {"threads": 1}))
     st_default_desc = f"threads=0, all {os.cpu_count()} cores" if has_threads else "no threads option"
-    original_extract = surftrack.extract
+    original_binding = binding.marching_cubes_array
 
     def time_marching_cubes(name, volume, level, force, repeat):
-        captured = {"timings": [], "extract_s": []}
+        captured = {"timings": [], "extract_s": [], "components": 0}
 
         def spy(*a, **k):
             t0 = time.perf_counter()
-            s = original_extract(*a, **{**k, **force})
+            out = original_binding(*a, **k)
             captured["extract_s"].append(time.perf_counter() - t0)
-            captured["timings"].append(dict(s.timings))
-            captured["call"] = (a, {**k, **force})
-            captured["components"] = len(s.components)
-            return s
+            captured["timings"].append(dict(out[-1]))
+            return out
 
-        surftrack.extract = spy
+        binding.marching_cubes_array = spy
         try:
-            times, (v, f, n, vals) = timed(lambda: surftrack.marching_cubes(volume, level), repeat)
+            times, (v, f, n, vals) = timed(lambda: surftrack.marching_cubes(volume, level, **force), repeat)
         finally:
-            surftrack.extract = original_extract
+            binding.marching_cubes_array = original_binding
         assert len(f) > 0 and len(v) > 0, f"{name}: surftrack.marching_cubes returned an empty mesh"
         assert f.min() >= 0 and f.max() < len(v), f"{name}: face indices out of range"
         assert len(n) == len(v) == len(vals), f"{name}: normals/values do not match the vertices"
@@ -406,25 +404,15 @@ def main(argv=None) -> int:
             st[label] = (times, tris, chi, cap)
             breakdowns.append((name, f"marching_cubes, {label}", cap["timings"][-1], statistics.median(times),
                                statistics.median(cap["extract_s"]),
-                               statistics.median(sum(t.values()) for t in cap["timings"]), cap["components"]))
+                               statistics.median(sum(v for k, v in t.items() if k != "arrays")
+                                                 for t in cap["timings"]), cap["components"]))
             if args.breakdown:
-                a, k = cap["call"]
-                gc.collect()
-                t0 = time.perf_counter()
-                s = original_extract(*a, **k)
-                t1 = time.perf_counter()
-                _ = s.normals
-                t2 = time.perf_counter()
-                _ = s.surfels
-                t3 = time.perf_counter()
-                core1 = sum(s.timings.values())
-                rest = statistics.median(times) - (t3 - t0)
-                print(f"   breakdown ({label}, one more call, not in the medians): extract() "
-                      f"{1000 * (t1 - t0):.1f} ms (core stages {1000 * core1:.1f}, the rest "
-                      f"{1000 * (t1 - t0 - core1):.1f}), .normals {1000 * (t2 - t1):.1f} ms, .surfels "
-                      f"{1000 * (t3 - t2):.1f} ms; median wall minus these {1000 * rest:.1f} ms "
-                      f"(range check, dtype conversions, values)", flush=True)
-                del s, _
+                t = cap["timings"][-1]
+                core1 = sum(v for k, v in t.items() if k != "arrays")
+                print(f"   breakdown ({label}, the last timed call): the binding {1000 * cap['extract_s'][-1]:.1f} ms "
+                      f"(core stages {1000 * core1:.1f}, the four arrays {1000 * t.get('arrays', 0):.1f}); "
+                      f"median wall minus the binding's median {1000 * (statistics.median(times) - statistics.median(cap['extract_s'])):.1f} ms "
+                      f"(range check, arguments)", flush=True)
         st_tris, chi_st = st["default"][1], st["default"][2]
 
         # (a) scikit-image
@@ -529,10 +517,11 @@ def main(argv=None) -> int:
         print(f"{r['image']:<30} {r['tool']:<50} {r['median_s']:9.4f} {r['triangles']:>11,} "
               f"{fmt(r['ratio']):>8} {fmt(r['ratio_1t']):>8}  {r['reps']}")
 
-    print("\nWhere surftrack's time goes (ms, medians; the stages are Surface.timings of the last run):")
+    print("\nWhere surftrack's time goes (ms, medians; the stages are Surface.timings of the last run, "
+          "marching_cubes' with \"arrays\", its binding writing the four arrays, outside the core):")
     for name, what, timings, wall, in_extract, core, components in breakdowns:
         stages = ", ".join(f"{k} {1000 * v:.1f}" for k, v in timings.items())
-        extra = f", extract() {1000 * in_extract:.1f}" if in_extract is not None else ""
+        extra = f", binding {1000 * in_extract:.1f}" if in_extract is not None else ""
         print(f"  {name:<20} {what:<27} wall {1000 * wall:8.1f}{extra}, core {1000 * core:.1f} "
               f"({stages}); {components:,} components")
 

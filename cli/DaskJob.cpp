@@ -109,6 +109,8 @@ json storeJob(const InputOptions& input, const std::string& dask, std::array<int
   job["direction"] = {numbers(geometry.direction[0]), numbers(geometry.direction[1]), numbers(geometry.direction[2])};
   job["block"] = {block[0], block[1], block[2]};
   job["work_dir"] = workDir.empty() ? json(nullptr) : json(fs::absolute(workDir).string());
+  job["store_format"] = store.format;  // the unit of the spacing (cli/PrecomputedOutput.h, SpacingUnit)
+  job["store_unit"] = store.unit;
   return job;
 }
 

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "DaskJob.h"
+#include "PrecomputedOutput.h"
 
 namespace surftrack::cli {
 
@@ -26,6 +27,16 @@ std::vector<LabelRow> labelRowsOnDask(const LabelsOptions& o, const LabelNames& 
   job["names"] = named;
   job["binary"] = !o.ascii;
   job["quiet"] = o.out.quiet;
+  const bool precomputed = !o.format.empty();
+  if (precomputed) {
+    // The reduce tasks encode each label as the single pass' writers do (PrecomputedOutput.h),
+    // from the same physical vertices, with the same unit.
+    job["format"] = o.format;
+    job["lods"] = o.format == "precomputed" ? 0 : o.precomputed.lods;
+    job["sharded"] = o.precomputed.sharded;
+    job["quantization_bits"] = o.precomputed.quantizationBits;
+    job["nanometres"] = nanometresOf({o.unit, job["store_unit"].get<std::string>(), job["store_format"].get<std::string>()});
+  }
   const json result = runDaskJob(job, staging, staging);
   if (!result.is_array()) throw std::runtime_error("the Dask driver gave no table");
 
@@ -45,6 +56,12 @@ std::vector<LabelRow> labelRowsOnDask(const LabelsOptions& o, const LabelNames& 
     r.genus = (2.0 * double(r.boundaries) - double(r.euler)) / 2.0;
     r.area = f["area"].get<double>();
     r.volume = f["volume"].get<double>();
+    if (precomputed) {  // the segment's manifest (sharded: the shard file holds it), as the single pass
+      r.file = o.precomputed.sharded ? o.output
+               : (fs::path(o.output) / (r.label.text() + (o.format == "precomputed" ? ":0" : ".index"))).string();
+      rows.push_back(std::move(r));
+      continue;
+    }
     r.file = (fs::path(o.output) / f["file"].get<std::string>()).string();  // as the single pass names it
     if (!files.insert(r.file).second)
       throw UsageError("two labels give the file name '" + r.file + "': their names are the same");

@@ -102,7 +102,11 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   if (!o.table.empty()) requireNoInput(o.table);
   if (!namesFile.empty()) names = readLabelNames(namesFile);
   if (precomputed) requireOutputDirectory(o.output);  // before the work
-  StagedOutputs staged = kind == OutputKind::Directory && !precomputed ? StagedOutputs::inDirectory(o.output) : StagedOutputs();
+  // The single pass' precomputed writers stage their own directory; on Dask the tasks write
+  // into this one (DaskLabels.h).
+  StagedOutputs staged = kind == OutputKind::Directory && (!precomputed || !o.dask.empty())
+                             ? StagedOutputs::inDirectory(o.output)
+                             : StagedOutputs();
 
   StageClock clock;
   LabelsRun run;
@@ -115,7 +119,8 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
     if (o.walls != "independent") throw UsageError("--walls shared is not made by blocks yet: no --dask");
     run.rows = labelRowsOnDask(o, names, staged);
     clock.lap(timings, "dask");
-    writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(run.rows));
+    if (!precomputed)  // a Neuroglancer directory holds its format's files only, as the single pass writes it
+      writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(run.rows));
     staged.commit();
     if (!o.table.empty()) writeText(o.table, tableText(o.table, run.rows));
     clock.lap(timings, "write");

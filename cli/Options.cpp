@@ -889,9 +889,9 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   }
   if (o.largest && !o.seeds.empty()) throw UsageError("give --largest or --seed, not both");
   parseDaskOptions(o.dask, a.block, o.workDir, o.block);
-  if (!o.dask.empty() && (o.largest || !o.seeds.empty() || !o.labels.empty() || o.range || !o.format.empty()))
-    throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest, "
-                     "--seed or --format yet");
+  if (!o.dask.empty() && (o.largest || !o.seeds.empty() || !o.labels.empty() || o.range))
+    throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest "
+                     "or --seed yet");
   if (o.smoothIterations > 0 && o.walls != "shared")
     throw UsageError("--smooth on labels needs --walls shared: each label smoothed on its own would pull the "
                      "vertices it shares with its neighbours apart");

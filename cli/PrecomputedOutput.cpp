@@ -4,6 +4,7 @@
 #include <map>
 
 #include "MultiresolutionMeshes.h"
+#include "PrecomputedFrame.h"
 
 namespace surftrack::cli {
 
@@ -19,6 +20,8 @@ double nanometresPer(const std::string& unit) {
   return it == units.end() ? 0.0 : it->second;
 }
 
+}  // namespace
+
 double nanometresOf(const SpacingUnit& u) {
   std::string unit = u.option;
   if (unit.empty()) unit = u.fileUnit;
@@ -30,57 +33,31 @@ double nanometresOf(const SpacingUnit& u) {
   return k;
 }
 
-}  // namespace
-
 void writePrecomputedOutput(const std::vector<OutputSegment>& segments, const std::string& directory,
                             const std::string& format, const ImageGeometry& g, const SpacingUnit& unit,
                             const PrecomputedOptions& options) {
   const double k = nanometresOf(unit);
   if (format == "precomputed") {
-    // Physical coordinates scaled, plus half a voxel along each voxel axis: Neuroglancer draws
-    // voxel i over [i, i + 1) where the physical coordinates put its centre at i.
-    ToNanometres m;
-    for (int r = 0; r < 3; ++r) {
-      m.linear[r] = {r == 0 ? k : 0.0, r == 1 ? k : 0.0, r == 2 ? k : 0.0};
-      double shift = 0;
-      for (int e = 0; e < 3; ++e) shift += g.direction[r][e] * g.spacing[e] / 2;
-      m.offset[r] = k * shift;
-    }
     std::vector<PrecomputedSegment> out;
     for (const OutputSegment& s : segments)
       out.push_back({s.id, &s.surface->vertices, &s.surface->triangles, s.name});
-    writePrecomputedMeshes(out, directory, m);
+    writePrecomputedMeshes(out, directory, legacyFrame(g, k));
     return;
   }
-  // Voxel indices: index p is at k * (origin + D diag(s) (p + 1/2)) nanometres.
-  ToNanometres m;
-  for (int r = 0; r < 3; ++r) {
-    double shift = 0;
-    for (int c = 0; c < 3; ++c) {
-      m.linear[r][c] = k * g.direction[r][c] * g.spacing[c];
-      shift += g.direction[r][c] * g.spacing[c] / 2;
-    }
-    m.offset[r] = k * (g.origin[r] + shift);
-  }
-  // Triangles face out in physical space; in index space too unless the geometry mirrors.
-  const bool mirrors = g.handedness() < 0;
   std::vector<std::vector<std::array<double, 3>>> vertices(segments.size());
   std::vector<std::vector<std::array<std::uint32_t, 3>>> triangles(segments.size());
   std::vector<PrecomputedSegment> out;
   for (std::size_t i = 0; i < segments.size(); ++i) {
-    const Surface& s = *segments[i].surface;
-    vertices[i].reserve(s.vertices.size());
-    for (const auto& p : s.vertices) vertices[i].push_back(g.toIndex(p));
-    triangles[i] = s.triangles;
-    if (mirrors)
-      for (auto& t : triangles[i]) std::swap(t[1], t[2]);
+    vertices[i] = segments[i].surface->vertices;
+    triangles[i] = segments[i].surface->triangles;
+    toVoxelIndices(g, vertices[i], triangles[i]);
     out.push_back({segments[i].id, &vertices[i], &triangles[i], segments[i].name});
   }
   refine::MultiresolutionOptions o;
   o.lods = options.lods;
   o.sharded = options.sharded;
   o.quantizationBits = options.quantizationBits;
-  refine::writeMultiresolutionMeshes(out, directory, m, o);
+  refine::writeMultiresolutionMeshes(out, directory, multiresFrame(g, k), o);
 }
 
 }  // namespace surftrack::cli

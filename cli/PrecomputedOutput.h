@@ -19,6 +19,9 @@ struct SpacingUnit {
   std::string fileFormat;  ///< "raw", "nii", "zarr", ...
 };
 
+/// Nanometres per unit of the spacing. \throw UsageError as SpacingUnit says.
+double nanometresOf(const SpacingUnit& unit);
+
 /// One segment to write: its id, its surface (physical coordinates) and its name.
 struct OutputSegment {
   LabelValue id;

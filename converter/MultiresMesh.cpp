@@ -28,15 +28,11 @@ std::uint64_t zOrder(const Cell& c) {
   return key;
 }
 
-struct Encoded {
-  std::string manifest, data;
-};
-
 class SegmentEncoder {
  public:
   SegmentEncoder(const MultiresSegment& s, int bits, bool reverse) : s_(s), bits_(bits), reverse_(reverse) {}
 
-  Encoded encode() {
+  EncodedMultiresSegment encode() {
     const OctreeGrid& g = s_.grid;
     const int lods = g.lods;
     // The nodes of each level: the cells its triangles lie in, and the parents of the nodes
@@ -57,7 +53,7 @@ class SegmentEncoder {
           nodes[std::size_t(k)][zOrder(parent)].first = parent;
         }
     }
-    Encoded out;
+    EncodedMultiresSegment out;
     std::string& m = out.manifest;
     for (int a = 0; a < 3; ++a) appendLittleEndian(m, float(g.chunk[std::size_t(a)]));
     for (int a = 0; a < 3; ++a) appendLittleEndian(m, float(g.origin[std::size_t(a)]));
@@ -172,6 +168,29 @@ void checkSegment(const MultiresSegment& s) {
 
 }  // namespace
 
+EncodedMultiresSegment encodeMultiresSegment(const MultiresSegment& segment, int quantizationBits, bool reverse) {
+  if (quantizationBits != 10 && quantizationBits != 16)
+    throw std::invalid_argument("vertex quantization bits must be 10 or 16 (the format allows no other), not " +
+                                std::to_string(quantizationBits));
+  checkSegment(segment);
+  return SegmentEncoder(segment, quantizationBits, reverse).encode();
+}
+
+std::string multiresInfoBytes(const ToNanometres& toNanometres, const MultiresFormat& format, bool named) {
+  nlohmann::ordered_json info = {{"@type", "neuroglancer_multilod_draco"},
+                                 {"vertex_quantization_bits", format.quantizationBits}};
+  nlohmann::ordered_json transform = nlohmann::ordered_json::array();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) transform.push_back(toNanometres.linear[std::size_t(r)][std::size_t(c)]);
+    transform.push_back(toNanometres.offset[std::size_t(r)]);
+  }
+  info["transform"] = transform;
+  info["lod_scale_multiplier"] = 1.0;
+  if (format.sharding) info["sharding"] = format.sharding->json();
+  if (named) info["segment_properties"] = "segment_properties";
+  return info.dump() + "\n";
+}
+
 void writePrecomputedMultires(const std::vector<MultiresSegment>& segments, const std::string& directory,
                               const ToNanometres& toNanometres, const MultiresFormat& format) {
   const std::filesystem::path target = precomputedTarget(directory);
@@ -186,24 +205,13 @@ void writePrecomputedMultires(const std::vector<MultiresSegment>& segments, cons
   const bool named = checkSegmentIds(ids);
   for (const MultiresSegment& s : segments) checkSegment(s);
 
-  std::vector<Encoded> encoded(segments.size());
+  std::vector<EncodedMultiresSegment> encoded(segments.size());
   tbb::parallel_for(std::size_t(0), segments.size(), [&](std::size_t i) {
     encoded[i] = SegmentEncoder(segments[i], format.quantizationBits, det < 0).encode();
   });
 
   StagingDirectory staging(target, directory);
-  nlohmann::ordered_json info = {{"@type", "neuroglancer_multilod_draco"},
-                                 {"vertex_quantization_bits", format.quantizationBits}};
-  nlohmann::ordered_json transform = nlohmann::ordered_json::array();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) transform.push_back(toNanometres.linear[std::size_t(r)][std::size_t(c)]);
-    transform.push_back(toNanometres.offset[std::size_t(r)]);
-  }
-  info["transform"] = transform;
-  info["lod_scale_multiplier"] = 1.0;
-  if (format.sharding) info["sharding"] = format.sharding->json();
-  if (named) info["segment_properties"] = "segment_properties";
-  staging.write("info", info.dump() + "\n");
+  staging.write("info", multiresInfoBytes(toNanometres, format, named));
   if (format.sharding) {
     std::vector<ShardChunk> chunks;
     for (std::size_t i = 0; i < segments.size(); ++i)

@@ -46,6 +46,20 @@ struct MultiresFormat {
   std::optional<ShardingSpec> sharding;    ///< nothing: unsharded
 };
 
+/// One segment encoded as writePrecomputedMultires stores it (what a task that encodes some of
+/// the segments writes, python/surftrack/distributed.py): `manifest` is `<id>.index` (sharded:
+/// the value of key <id>), `data` the fragments (`<id>`; sharded: the bytes before the value).
+struct EncodedMultiresSegment {
+  std::string manifest, data;
+};
+/// \param reverse the map to nanometres mirrors (the triangles are written reversed).
+/// \throw std::invalid_argument as writePrecomputedMultires, for this segment.
+EncodedMultiresSegment encodeMultiresSegment(const MultiresSegment& segment, int quantizationBits, bool reverse);
+
+/// The `info` file of the multi-resolution format (the sharding spec in it when sharded, the
+/// segment properties named when some segment is).
+std::string multiresInfoBytes(const ToNanometres& toNanometres, const MultiresFormat& format, bool named);
+
 /// Writes `segments` at `directory`, whole or not at all (as writePrecomputedMeshes), with
 /// `toNanometres` as the info's transform from the stored model coordinates. A vertex of a
 /// fragment of level k, cell c, is quantized to round(((p - origin) / (chunk 2^k) - c) (2^b - 1))

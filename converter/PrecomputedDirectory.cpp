@@ -84,7 +84,7 @@ void StagingDirectory::write(const std::string& name, const std::string& bytes) 
   if (!out) throw cannotWrite(shown_, errno != 0 ? errno : EIO);
 }
 
-void StagingDirectory::writeSegmentProperties(const std::vector<std::pair<LabelValue, std::string>>& names) {
+std::string segmentPropertiesBytes(const std::vector<std::pair<LabelValue, std::string>>& names) {
   nlohmann::ordered_json ids = nlohmann::ordered_json::array(), values = nlohmann::ordered_json::array();
   for (const auto& [id, name] : names) {
     ids.push_back(id.text());
@@ -93,8 +93,12 @@ void StagingDirectory::writeSegmentProperties(const std::vector<std::pair<LabelV
   const nlohmann::ordered_json properties = {
       {"@type", "neuroglancer_segment_properties"},
       {"inline", {{"ids", ids}, {"properties", {{{"id", "label"}, {"type", "label"}, {"values", values}}}}}}};
+  return properties.dump() + "\n";
+}
+
+void StagingDirectory::writeSegmentProperties(const std::vector<std::pair<LabelValue, std::string>>& names) {
   makeDirectory("segment_properties");
-  write("segment_properties/info", properties.dump() + "\n");
+  write("segment_properties/info", segmentPropertiesBytes(names));
 }
 
 void StagingDirectory::commit() {

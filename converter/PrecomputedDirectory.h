@@ -35,6 +35,10 @@ std::filesystem::path precomputedTarget(const std::string& directory);
 /// Returns whether any segment is named. \throw std::invalid_argument naming the id.
 bool checkSegmentIds(const std::vector<std::pair<LabelValue, const std::string*>>& segments);
 
+/// The bytes of `segment_properties/info`: each segment's name (Neuroglancer's "label"
+/// property), in the order given.
+std::string segmentPropertiesBytes(const std::vector<std::pair<LabelValue, std::string>>& names);
+
 /// The hidden directory the outputs are written into, beside the target, its files registered
 /// as live temporaries as they are created (converter/TemporaryFiles.h: a SIGINT removes
 /// them); removed with what it holds unless committed, then renamed into place.

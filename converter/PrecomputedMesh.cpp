@@ -17,8 +17,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+}  // namespace
+
 /// The fragment file of one segment: vertex count, float32 x y z in nanometres, triangles.
-std::string fragmentBytes(const PrecomputedSegment& s, const ToNanometres& m) {
+std::string legacyFragmentBytes(const PrecomputedSegment& s, const ToNanometres& m) {
+  if (!s.vertices || !s.triangles) throw std::invalid_argument("segment " + s.id.text() + " has no mesh");
   const auto& vertices = *s.vertices;
   const auto& triangles = *s.triangles;
   if (vertices.size() > std::numeric_limits<std::uint32_t>::max())
@@ -50,7 +53,15 @@ std::string fragmentBytes(const PrecomputedSegment& s, const ToNanometres& m) {
   return out;
 }
 
-}  // namespace
+std::string legacyManifestBytes(const LabelValue& id) {
+  return nlohmann::ordered_json{{"fragments", {id.text() + ".mesh"}}}.dump() + "\n";
+}
+
+std::string legacyInfoBytes(bool named) {
+  nlohmann::ordered_json info = {{"@type", "neuroglancer_legacy_mesh"}};
+  if (named) info["segment_properties"] = "segment_properties";
+  return info.dump() + "\n";
+}
 
 void writePrecomputedMeshes(const std::vector<PrecomputedSegment>& segments, const std::string& directory,
                             const ToNanometres& toNanometres) {
@@ -66,13 +77,11 @@ void writePrecomputedMeshes(const std::vector<PrecomputedSegment>& segments, con
   const bool named = checkSegmentIds(ids);
 
   StagingDirectory staging(target, directory);
-  nlohmann::ordered_json info = {{"@type", "neuroglancer_legacy_mesh"}};
-  if (named) info["segment_properties"] = "segment_properties";
-  staging.write("info", info.dump() + "\n");
+  staging.write("info", legacyInfoBytes(named));
   for (const PrecomputedSegment& s : segments) {
     const std::string id = s.id.text();
-    staging.write(id + ".mesh", fragmentBytes(s, toNanometres));
-    staging.write(id + ":0", nlohmann::ordered_json{{"fragments", {id + ".mesh"}}}.dump() + "\n");
+    staging.write(id + ".mesh", legacyFragmentBytes(s, toNanometres));
+    staging.write(id + ":0", legacyManifestBytes(s.id));
   }
   if (named) {
     std::vector<std::pair<LabelValue, std::string>> names;

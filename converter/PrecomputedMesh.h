@@ -39,6 +39,14 @@ struct ToNanometres {
   }
 };
 
+/// The files of one segment, as writePrecomputedMeshes writes them (what a task that encodes
+/// some of the segments writes, python/surftrack/distributed.py): `<id>.mesh` (the fragment)
+/// and `<id>:0` (its manifest). \throw std::invalid_argument as writePrecomputedMeshes.
+std::string legacyFragmentBytes(const PrecomputedSegment& segment, const ToNanometres& toNanometres);
+std::string legacyManifestBytes(const LabelValue& id);
+/// The `info` file of the legacy format, with segment properties when some segment is named.
+std::string legacyInfoBytes(bool named);
+
 /// Writes `segments` as a legacy precomputed mesh directory at `directory`, whole or not at
 /// all: into a hidden directory beside it, renamed into place at the end (`directory` must not
 /// exist or be empty; a handler of SIGINT removes the hidden one, converter/TemporaryFiles.h).

@@ -26,6 +26,7 @@
 
 #include "ConfigurationTable.h"
 #include "DigitalCube.h"
+#include "HugePages.h"
 
 #include <boost/pending/disjoint_sets.hpp>
 #include <tbb/parallel_for.h>
@@ -126,8 +127,10 @@ class Scanner {
     if (layout.vertexStart[slabs] > std::numeric_limits<std::uint32_t>::max())
       throw std::length_error("scanIsoSurface: more than 2^32 - 1 boundary surfels");
     TriangleMesh mesh;
-    mesh.surfels.resize(layout.vertexStart[slabs]);
-    mesh.triangles.resize(layout.triangleStart[slabs]);
+    // On huge pages (lib/HugePages.h): the mesh is written once, and the front door hands its
+    // triangles to the caller as they are (python/src/MarchingCubes.cpp).
+    resizeHugePages(mesh.surfels, layout.vertexStart[slabs]);
+    resizeHugePages(mesh.triangles, layout.triangleStart[slabs]);
     const int runs = runCount(slabs);
     forEach(0, runs, [&](int r) {
       const auto [first, last] = runSlabs(r, runs, slabs);

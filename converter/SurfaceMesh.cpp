@@ -48,34 +48,6 @@ void checkSizes(const char* who, const TriangleMesh& mesh,
                                     " uses vertex " + std::to_string(v) + " out of range");
 }
 
-/// An uninitialised array of n trivial values, on fresh memory. From 1 MiB on, the memory is
-/// whole 2 MiB pages (aligned, the size rounded up) advised for huge pages: written once at
-/// random, it would otherwise cost a page fault per 4 KiB, the first and last 2 MiB of an
-/// unaligned block included (lib/HugePages.h, docs/performance.md 'Fresh memory on this
-/// machine').
-struct FreeDeleter {
-  void operator()(void* p) const { std::free(p); }
-};
-template <class T>
-using FreshArray = std::unique_ptr<T[], FreeDeleter>;
-
-template <class T>
-FreshArray<T> freshArray(std::size_t n) {
-  static_assert(std::is_trivially_default_constructible_v<T> && std::is_trivially_destructible_v<T>);
-  constexpr std::size_t kHuge = std::size_t(1) << 21;
-  const std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
-  void* p = nullptr;
-  if (bytes >= kHuge / 2) {
-    const std::size_t rounded = (bytes + kHuge - 1) & ~(kHuge - 1);
-    p = std::aligned_alloc(kHuge, rounded);
-    if (p) adviseHugePages(p, rounded);
-  } else {
-    p = std::malloc(bytes);
-  }
-  if (!p) throw std::bad_alloc();
-  return FreshArray<T>(static_cast<T*>(p));
-}
-
 [[noreturn]] void notAManifold(const std::string& what) {
   throw std::logic_error("toSurfaceMesh: " + what +
                          ": the triangles are not a closed oriented manifold");

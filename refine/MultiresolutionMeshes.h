@@ -24,6 +24,18 @@ struct MultiresolutionOptions {
   const std::atomic<bool>* cancel = nullptr;
 };
 
+/// \throw std::invalid_argument for options out of range.
+void checkMultiresolutionOptions(const MultiresolutionOptions& options);
+
+/// One segment's grid and levels of detail, as writeMultiresolutionMeshes makes them (what a
+/// task that encodes some of the segments calls, python/surftrack/distributed.py).
+/// \throw std::invalid_argument as writeMultiresolutionMeshes, for this segment; Cancelled.
+MultiresSegment multiresolutionSegment(const PrecomputedSegment& segment, const MultiresolutionOptions& options);
+
+/// The format of `count` segments: the sharding layout (ShardedFormat.h, shardingFor) depends
+/// on the count of every segment written, not only on those a task encodes.
+MultiresFormat multiresolutionFormat(std::size_t count, const MultiresolutionOptions& options);
+
 /// Writes `segments` (vertices in the stored model's units, triangles facing out in them) at
 /// `directory` with `toNanometres` as the transform, whole or not at all. The directory is
 /// checked before any work.

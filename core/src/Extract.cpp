@@ -10,6 +10,7 @@
 
 #include "BoundaryMapping.h"
 #include "FindSeed.h"
+#include "HugePages.h"
 #include "LoopExtraction.h"
 #include "ScanIsoSurface.h"
 #include "PhysicalRange.h"
@@ -199,7 +200,7 @@ void placeSurface(const VoxelSource& source, TriangleMesh&& mesh, Mapping mappin
                   const Selection& selection, double epsilon, Surface& out, int threads) {
   const ImageGeometry geometry = source.geometry();
   const std::size_t n = mesh.surfels.size();
-  out.vertices.resize(n);
+  resizeHugePages(out.vertices, n);  // written once (lib/HugePages.h)
   // Runs of up to 2^15 vertices, each placed on its own (the source may be read from several
   // threads at once); the same points for any number of threads.
   const std::size_t kRun = std::clamp<std::size_t>(n / 64, 1024, std::size_t(1) << 15);

@@ -12,9 +12,6 @@
 
 #include <atomic>
 #include <cstring>
-#include <chrono>
-#include <future>
-#include <regex>
 #include <system_error>
 
 #include <surftrack/Extract.h>
@@ -26,13 +23,18 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include "ArrayChunkProvider.h"
+#include "EngineCalls.h"  // arrays as views, Ctrl-C, errors in array axes
+#include "MarchingCubes.h"
 #include "ChunkedStore.h"  // io/: zarr, OME-Zarr, N5
 #include "ReadVolume.h"    // io/: ReadError
 #include "PrecomputedMesh.h"  // converter/: Neuroglancer's format
 #include "MultiresolutionMeshes.h"  // refine/: its multi-resolution variant
+#include "PrecomputedFrame.h"  // converter/: the CLI's frames of both
+#include "PrecomputedDirectory.h"  // converter/: segment ids and properties
 
 namespace py = pybind11;
 using namespace surftrack;
+using namespace surftrack::binding;
 
 namespace {
 
@@ -72,123 +74,6 @@ py::int_ labelObject(const LabelValue& L) {
   return py::reinterpret_steal<py::int_>(PyLong_FromUnsignedLongLong(L.magnitude()));
 }
 
-/// The ScalarType of a numpy dtype; throws TypeError for anything but the ten types.
-ScalarType scalarTypeOfDtype(const py::dtype& dtype) {
-  const char kind = dtype.kind();
-  const auto size = dtype.itemsize();
-  if (kind == 'u' || kind == 'b') {
-    if (size == 1) return ScalarType::UInt8;
-    if (size == 2) return ScalarType::UInt16;
-    if (size == 4) return ScalarType::UInt32;
-    if (size == 8) return ScalarType::UInt64;
-  } else if (kind == 'i') {
-    if (size == 1) return ScalarType::Int8;
-    if (size == 2) return ScalarType::Int16;
-    if (size == 4) return ScalarType::Int32;
-    if (size == 8) return ScalarType::Int64;
-  } else if (kind == 'f') {
-    if (size == 4) return ScalarType::Float32;
-    if (size == 8) return ScalarType::Float64;
-  }
-  throw py::type_error("unsupported volume dtype '" + py::cast<std::string>(py::str(py::handle(dtype))) +
-                       "': expected bool, uint8/16/32/64, int8/16/32/64, float32 or float64");
-}
-
-/// The largest volume dimension the engine takes (core/src/ViewSource.cpp: surfel keys hold 20
-/// bits per coordinate, with a voxel of margin on each side).
-constexpr int kMaxDimension = Surfel::kCoordinateLimit - 3;
-
-/// Runs `work` (engine code that touches no Python object without taking the GIL) on a worker
-/// thread while the calling thread watches for Ctrl-C: Python runs its signal handlers on the
-/// main thread only, between bytecodes, and the engine's long loops (tracking, scanning,
-/// smoothing, decimation, writing) check `cancel` instead. Every 50 ms the caller takes the GIL
-/// and runs the pending handlers (PyErr_CheckSignals); one that raises (KeyboardInterrupt for
-/// SIGINT) raises `cancel`, and once the work has stopped at its next check that exception is
-/// raised here. Otherwise the work's own exception, if any, is rethrown here.
-template <class Work>
-void runWatchingSignals(std::atomic<bool>& cancel, Work&& work) {
-  std::future<void> done = std::async(std::launch::async, std::forward<Work>(work));
-  for (;;) {
-    bool finished;
-    {
-      py::gil_scoped_release release;
-      finished = done.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready;
-    }
-    if (finished) break;
-    if (PyErr_CheckSignals() != 0) {
-      py::error_already_set interrupt;  // the handler's exception, fetched
-      cancel = true;
-      {
-        py::gil_scoped_release release;
-        done.wait();
-      }
-      try {
-        done.get();
-      } catch (...) {  // Cancelled, or whatever came first: the interrupt is what the caller asked
-      }
-      throw interrupt;
-    }
-  }
-  done.get();
-}
-
-/// Applies `format` to every match of `re` in `text`.
-template <class Format>
-std::string replaceMatches(const std::string& text, const std::regex& re, Format&& format) {
-  std::string out;
-  auto last = text.cbegin();
-  for (std::sregex_iterator it(text.begin(), text.end(), re), end; it != end; ++it) {
-    out.append(last, (*it)[0].first);
-    out += format(*it);
-    last = (*it)[0].second;
-  }
-  out.append(last, text.cend());
-  return out;
-}
-
-/// An engine message with its voxel coordinates in the caller's axes: the engine's x, y, z are
-/// the array axes order[0..2] (surftrack/__init__.py), and its messages print a voxel as
-/// "(x,y,z)" after "voxel ", "voxel index " or, in a surfel, "c=" and "d=", and a domain as
-/// "[0,nx)x[0,ny)x[0,nz)" (core/src/Extract.cpp, core/src/Labels.cpp). Physical points are in
-/// the caller's frame already and are left alone.
-std::string inArrayAxes(const std::string& message, std::array<int, 3> order) {
-  static const std::regex voxel(R"re((voxel |voxel index |c=|d=)\(([^,()]+),([^,()]+),([^,()]+)\))re");
-  static const std::regex domain(R"re(\[0,(\d+)\)x\[0,(\d+)\)x\[0,(\d+)\))re");
-  auto permuted = [&](const std::smatch& m, int first) {
-    std::array<std::string, 3> a;
-    for (int e = 0; e < 3; ++e) a[std::size_t(order[e])] = m[first + e].str();
-    return a;
-  };
-  const std::string voxels = replaceMatches(message, voxel, [&](const std::smatch& m) {
-    const auto a = permuted(m, 2);
-    return m[1].str() + "(" + a[0] + "," + a[1] + "," + a[2] + ")";
-  });
-  return replaceMatches(voxels, domain, [&](const std::smatch& m) {
-    const auto a = permuted(m, 1);
-    return "[0," + a[0] + ")x[0," + a[1] + ")x[0," + a[2] + ")";
-  });
-}
-
-/// runWatchingSignals for the engine's extractions: their errors' voxels in the caller's axes.
-template <class Work>
-void runEngine(std::array<int, 3> order, std::atomic<bool>& cancel, Work&& work) {
-  try {
-    runWatchingSignals(cancel, std::forward<Work>(work));
-  } catch (const InvalidInput& e) {
-    throw InvalidInput(inArrayAxes(e.what(), order));
-  } catch (const InternalError& e) {
-    throw InternalError(inArrayAxes(e.what(), order));
-  }
-}
-
-/// A numpy array over `data` (shape `shape`), owned by the heap object `owner`: no copy.
-template <class T, class Owner>
-py::array_t<T> viewOf(T* data, std::vector<py::ssize_t> shape, std::shared_ptr<Owner> owner) {
-  auto* keep = new std::shared_ptr<Owner>(std::move(owner));
-  py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<Owner>*>(p); });
-  return py::array_t<T>(shape, data, base);
-}
-
 /// An extracted surface held for Python: its vectors are the numpy arrays (no copy); normals
 /// and surfels in array axes are computed on first use, without the GIL.
 struct Result {
@@ -220,32 +105,6 @@ struct Result {
     return viewOf(out->data(), {py::ssize_t(r->surface.surfels.size()), 2, 3}, out);
   }
 };
-
-/// The view of `volume` whose engine axes x, y, z are the array axes order[0..2], with its
-/// geometry given in array axes.
-VolumeView viewOfArray(const py::array& volume, std::array<int, 3> order, std::array<double, 3> spacing,
-                       std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction) {
-  if (volume.ndim() != 3)
-    throw py::value_error("the volume must be 3-D, not " + std::to_string(volume.ndim()) + "-D");
-  const ScalarType type = scalarTypeOfDtype(volume.dtype());
-  VolumeView view;
-  view.data = volume.data();
-  view.type = type;
-  for (int e = 0; e < 3; ++e) {
-    const int a = order[e];
-    if (volume.shape(a) == 0) throw py::value_error("the volume is empty (a dimension is 0)");
-    if (volume.shape(a) > kMaxDimension)
-      throw py::value_error("a volume dimension exceeds " + std::to_string(kMaxDimension));
-    if (volume.strides(a) % py::ssize_t(sizeOf(type)) != 0)
-      throw py::value_error("the volume's strides are not multiples of its item size");
-    (e == 0 ? view.dims.nx : e == 1 ? view.dims.ny : view.dims.nz) = int(volume.shape(a));
-    view.strides[e] = volume.strides(a) / py::ssize_t(sizeOf(type));
-    view.geometry.spacing[e] = spacing[a];
-    for (int k = 0; k < 3; ++k) view.geometry.direction[k][e] = direction[k][a];
-  }
-  view.geometry.origin = origin;
-  return view;
-}
 
 /// The arrays and figures of an extracted surface, as the keyword arguments of Python's Surface.
 py::dict surfaceDict(const std::shared_ptr<Result>& r) {
@@ -803,6 +662,35 @@ void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> 
   runWatchingSignals(cancel, [&] { writeSurface(s, path, binary, &cancel); });
 }
 
+/// A mesh's (N, 3) vertices and (M, 3) faces copied into the writers' arrays.
+void meshOf(py::handle vertexArray, py::handle faceArray, std::vector<std::array<double, 3>>& vertices,
+            std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  const auto v = vertexArray.cast<py::array_t<double, py::array::c_style | py::array::forcecast>>();
+  const auto f = faceArray.cast<py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>>();
+  if (v.ndim() != 2 || v.shape(1) != 3) throw py::value_error("vertices must be (N, 3)");
+  if (f.ndim() != 2 || f.shape(1) != 3) throw py::value_error("faces must be (M, 3)");
+  vertices.resize(std::size_t(v.shape(0)));
+  std::memcpy(vertices.data(), v.data(), vertices.size() * sizeof(vertices[0]));
+  triangles.resize(std::size_t(f.shape(0)));
+  const std::int64_t* fp = f.data();
+  for (std::size_t k = 0; k < 3 * triangles.size(); ++k) {
+    if (fp[k] < 0 || std::size_t(fp[k]) >= vertices.size())
+      throw py::value_error("a face refers to a vertex that does not exist");
+    triangles[k / 3][k % 3] = std::uint32_t(fp[k]);
+  }
+}
+
+/// The multi-resolution options of write_precomputed's arguments (sharding 1:
+/// murmurhash3_x86_128, 2: identity, 0: unsharded).
+refine::MultiresolutionOptions multiresOptions(int lods, int quantizationBits, int sharding) {
+  refine::MultiresolutionOptions o;
+  o.lods = lods;
+  o.quantizationBits = quantizationBits;
+  o.sharded = sharding != 0;
+  o.identityHash = sharding == 2;
+  return o;
+}
+
 /// Writes (label, vertices, faces, name) tuples as a Neuroglancer precomputed mesh directory
 /// (converter/PrecomputedMesh.h, or with lods > 0 the multi-resolution format of
 /// refine/MultiresolutionMeshes.h); `linear` and `offset` map the vertices to nanometres.
@@ -813,30 +701,14 @@ void writePrecomputed(const py::list& segments, const std::string& path, std::ar
   std::vector<PrecomputedSegment> out;
   for (std::size_t i = 0; i < segments.size(); ++i) {
     const py::tuple t = segments[i].cast<py::tuple>();
-    const auto v = t[1].cast<py::array_t<double, py::array::c_style | py::array::forcecast>>();
-    const auto f = t[2].cast<py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>>();
-    if (v.ndim() != 2 || v.shape(1) != 3) throw py::value_error("vertices must be (N, 3)");
-    if (f.ndim() != 2 || f.shape(1) != 3) throw py::value_error("faces must be (M, 3)");
-    vertices[i].resize(std::size_t(v.shape(0)));
-    std::memcpy(vertices[i].data(), v.data(), vertices[i].size() * sizeof(vertices[i][0]));
-    triangles[i].resize(std::size_t(f.shape(0)));
-    const std::int64_t* fp = f.data();
-    for (std::size_t k = 0; k < 3 * triangles[i].size(); ++k) {
-      if (fp[k] < 0 || std::size_t(fp[k]) >= vertices[i].size())
-        throw py::value_error("a face refers to a vertex that does not exist");
-      triangles[i][k / 3][k % 3] = std::uint32_t(fp[k]);
-    }
+    meshOf(t[1], t[2], vertices[i], triangles[i]);
     out.push_back({labelOf(t[0], "label"), &vertices[i], &triangles[i], t[3].cast<std::string>()});
   }
   try {
     if (lods == 0) {
       writePrecomputedMeshes(out, path, ToNanometres{linear, offset});
     } else {
-      refine::MultiresolutionOptions o;
-      o.lods = lods;
-      o.quantizationBits = quantizationBits;
-      o.sharded = sharding != 0;  // 1: murmurhash3_x86_128, 2: identity
-      o.identityHash = sharding == 2;
+      refine::MultiresolutionOptions o = multiresOptions(lods, quantizationBits, sharding);
       std::atomic<bool> cancel{false};
       o.cancel = &cancel;
       runWatchingSignals(cancel, [&] { refine::writeMultiresolutionMeshes(out, path, ToNanometres{linear, offset}, o); });
@@ -844,6 +716,111 @@ void writePrecomputed(const py::list& segments, const std::string& path, std::ar
   } catch (const std::invalid_argument& e) {
     throw py::value_error(e.what());
   }
+}
+
+// The pieces of write_precomputed for a writer that encodes its segments in many tasks
+// (python/surftrack/distributed.py, docs/python.md "Neuroglancer output on Dask"): each the
+// function the whole writer calls, so that the files are the same bytes.
+
+/// One segment's files: (manifest, data) = (`<id>:0`, `<id>.mesh`) for lods 0, else (`<id>.index`,
+/// `<id>`), the sharded layout's value and prefix. With `geometry` (spacing, origin, direction),
+/// the vertices are the command line's physical coordinates and lods > 0 stores their voxel
+/// indices as its single pass does (converter/PrecomputedFrame.h).
+py::tuple encodePrecomputedSegment(py::handle label, py::handle vertexArray, py::handle faceArray,
+                                   std::array<std::array<double, 3>, 3> linear, std::array<double, 3> offset, int lods,
+                                   int quantizationBits, std::optional<py::tuple> geometry) {
+  std::vector<std::array<double, 3>> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  meshOf(vertexArray, faceArray, vertices, triangles);
+  const LabelValue id = labelOf(label, "label");
+  try {
+    const std::string none;
+    checkSegmentIds({{id, &none}});
+    const ToNanometres m{linear, offset};
+    if (!std::isfinite(m.determinant()) || m.determinant() == 0)
+      throw std::invalid_argument("the map of the meshes to nanometres is singular or not finite");
+    if (lods == 0) {
+      const PrecomputedSegment s{id, &vertices, &triangles, ""};
+      return py::make_tuple(py::bytes(legacyManifestBytes(id)), py::bytes(legacyFragmentBytes(s, m)));
+    }
+    if (geometry) {
+      ImageGeometry g;
+      g.spacing = (*geometry)[0].cast<std::array<double, 3>>();
+      g.origin = (*geometry)[1].cast<std::array<double, 3>>();
+      g.direction = (*geometry)[2].cast<std::array<std::array<double, 3>, 3>>();
+      toVoxelIndices(g, vertices, triangles);
+    }
+    refine::MultiresolutionOptions o = multiresOptions(lods, quantizationBits, 0);
+    refine::checkMultiresolutionOptions(o);
+    std::atomic<bool> cancel{false};
+    o.cancel = &cancel;
+    EncodedMultiresSegment e;
+    runWatchingSignals(cancel, [&] {
+      e = encodeMultiresSegment(refine::multiresolutionSegment({id, &vertices, &triangles, ""}, o), quantizationBits,
+                                m.determinant() < 0);
+    });
+    return py::make_tuple(py::bytes(e.manifest), py::bytes(e.data));
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+/// The `info` file of `count` segments (the sharding layout depends on the count).
+py::bytes precomputedInfo(std::array<std::array<double, 3>, 3> linear, std::array<double, 3> offset, int lods,
+                          int quantizationBits, int sharding, std::size_t count, bool named) {
+  if (lods == 0) return py::bytes(legacyInfoBytes(named));
+  const refine::MultiresolutionOptions o = multiresOptions(lods, quantizationBits, sharding);
+  return py::bytes(multiresInfoBytes(ToNanometres{linear, offset}, refine::multiresolutionFormat(count, o), named));
+}
+
+/// `segment_properties/info` of (label, name) pairs, in their order.
+py::bytes segmentProperties(const py::list& pairs) {
+  std::vector<std::pair<LabelValue, std::string>> names;
+  for (py::handle p : pairs) {
+    const py::tuple t = p.cast<py::tuple>();
+    names.emplace_back(labelOf(t[0], "label"), t[1].cast<std::string>());
+  }
+  return py::bytes(segmentPropertiesBytes(names));
+}
+
+/// The sharded layout (sharding 1 or 2) of `count` segments.
+ShardingSpec shardingOf(int sharding, std::size_t count) {
+  if (sharding != 1 && sharding != 2) throw py::value_error("sharding must be 1 (murmurhash3_x86_128) or 2 (identity)");
+  return *refine::multiresolutionFormat(count, multiresOptions(1, 16, sharding)).sharding;
+}
+
+/// The shard number of each label in the sharded layout of `count` segments.
+std::vector<std::uint64_t> precomputedShards(const py::list& labels, int sharding, std::size_t count) {
+  const ShardingSpec spec = shardingOf(sharding, count);
+  std::vector<std::uint64_t> out;
+  for (py::handle L : labels) out.push_back(spec.shardOf(labelOf(L, "label").magnitude()));
+  return out;
+}
+
+/// The shard file(s) of (label, manifest, data) triples, as (name, bytes): all of one shard
+/// give one file, the same bytes as the whole writer's.
+py::list buildPrecomputedShard(const py::list& segments, int sharding, std::size_t count) {
+  const ShardingSpec spec = shardingOf(sharding, count);
+  std::vector<ShardChunk> chunks;
+  for (py::handle p : segments) {
+    const py::tuple t = p.cast<py::tuple>();
+    chunks.push_back({labelOf(t[0], "label").magnitude(), t[2].cast<std::string>(), t[1].cast<std::string>()});
+  }
+  py::list out;
+  for (auto& [name, bytes] : buildShards(spec, std::move(chunks))) out.append(py::make_tuple(name, py::bytes(bytes)));
+  return out;
+}
+
+/// The command line's map to nanometres of `geometry` and `nanometres` per unit
+/// (converter/PrecomputedFrame.h): (linear, offset).
+py::tuple cliPrecomputedFrame(std::array<double, 3> spacing, std::array<double, 3> origin,
+                              std::array<std::array<double, 3>, 3> direction, double nanometres, bool multires) {
+  ImageGeometry g;
+  g.spacing = spacing;
+  g.origin = origin;
+  g.direction = direction;
+  const ToNanometres m = multires ? multiresFrame(g, nanometres) : legacyFrame(g, nanometres);
+  return py::make_tuple(m.linear, m.offset);
 }
 
 }  // namespace
@@ -878,6 +855,7 @@ PYBIND11_MODULE(_surftrack, m) {
       .def("normals", &Result::normals)
       .def("surfels", &Result::surfels);
   m.def("extract_array", &extractArray);
+  defineMarchingCubes(m);
   m.def("extract_store", &extractStore);
   m.def("extract_chunked", &extractChunked);
   m.def("store_layout", &storeLayout);
@@ -885,6 +863,12 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
   m.def("write_precomputed", &writePrecomputed);
+  m.def("encode_precomputed_segment", &encodePrecomputedSegment);
+  m.def("precomputed_info", &precomputedInfo);
+  m.def("segment_properties", &segmentProperties);
+  m.def("precomputed_shards", &precomputedShards);
+  m.def("build_precomputed_shard", &buildPrecomputedShard);
+  m.def("cli_precomputed_frame", &cliPrecomputedFrame);
   m.def("scan_label_block", &scanLabelBlockArray);
   m.def("merge_label_fragments", &mergeLabelFragmentsArrays);
   m.def("scan_threshold_block", &scanThresholdBlockArray);

@@ -484,12 +484,14 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
 
 def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_direction="descent",
                    step_size=1, allow_degenerate=True, method="lewiner", mask=None,
-                   adjacency="26-6"):
+                   adjacency="26-6", threads=0):
     """A drop-in for ``skimage.measure.marching_cubes`` whose output is always a closed,
     oriented 2-manifold: every boundary of the image, by the scanning method.
 
-    Returns ``(verts, faces, normals, values)`` with scikit-image's shapes and dtypes. See
-    docs/python.md for what each argument does here and how the result differs.
+    Returns ``(verts, faces, normals, values)`` with scikit-image's shapes and dtypes, written
+    in parallel by the engine (``threads``, 0: all cores; the same arrays for any number). See
+    docs/python.md for what each argument does here and how the result differs; ``step_size``
+    other than 1, ``mask`` and ``allow_degenerate=False`` raise ValueError.
     """
     array = _as_volume(volume)
     lo, hi = float(np.nanmin(array)), float(np.nanmax(array))
@@ -504,23 +506,25 @@ def marching_cubes(volume, level=None, *, spacing=(1.0, 1.0, 1.0), gradient_dire
         raise ValueError("step_size other than 1 is not supported: surftrack never skips voxels")
     if mask is not None:
         raise ValueError("mask is not supported by surftrack.marching_cubes")
-    surface = extract(array, level=level, mode="all", adjacency=adjacency, mapping="linear",
-                      spacing=spacing, epsilon=1e-9, figures=False)
-    verts = surface.vertices.astype(np.float32)
-    faces = surface.faces.astype(np.int32)
-    normals = surface.normals.astype(np.float32)
-    # The larger of the two voxel values of each vertex's grid edge.
-    c, d = surface.surfels[:, 0], surface.surfels[:, 1]
-    inside = np.all((d >= 0) & (d < np.array(array.shape)), axis=1)
-    values = array[tuple(c.T)].astype(np.float32)
-    dv = array[tuple(np.where(inside[:, None], d, c).T)].astype(np.float32)
-    values = np.maximum(values, dv)
-    # scikit-image's winding: its faces are wound clockwise seen from the side the normals
-    # point to ("descent", the default) or counter-clockwise ("ascent"); its normals point
-    # down the gradient either way, as this engine's do (outwards from the voxels above the
-    # level). The engine winds counter-clockwise seen from outside.
-    if gradient_direction == "descent":
-        faces = np.ascontiguousarray(faces[:, ::-1])
+    if not allow_degenerate:
+        # Removing a triangle merges its vertices: the mesh would no longer be the closed
+        # 2-manifold of every boundary (docs/python.md, "Differences from scikit-image").
+        raise ValueError("allow_degenerate=False is not supported: surftrack keeps every triangle, so the "
+                         "mesh stays closed; a triangle is degenerate only where the level equals voxel "
+                         "values (offset the level slightly to avoid it)")
+    if adjacency not in _ADJACENCIES:
+        raise ValueError(f"unsupported adjacency pair '{adjacency}': expected one of "
+                         + ", ".join(_ADJACENCIES))
+    threads = _thread_count(threads)
+    spacing, _, _ = _geometry(spacing, None, None)
+    # The scan reads rows: a C-ordered copy if need be, as extract(mode="all") makes.
+    if not array.flags.c_contiguous:
+        array = np.ascontiguousarray(array)
+    try:
+        verts, faces, normals, values, _ = _surftrack.marching_cubes_array(
+            array, level, adjacency, spacing, gradient_direction == "descent", threads)
+    except ValueError as error:
+        raise type(error)(f"{error}{_range_note(array, level)}") from None
     return verts, faces, normals, values
 
 

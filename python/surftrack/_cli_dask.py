@@ -46,6 +46,23 @@ def _client(address):
     return Client(address, timeout="30s"), None
 
 
+def _precomputed(job):
+    """--format precomputed or precomputed-multires: the frame of the single pass' writers
+    (cli/PrecomputedOutput.cpp; the map computed by its own C++, converter/PrecomputedFrame.h),
+    the engine's geometry (the multi-resolution format stores voxel indices), the names. The
+    tasks write into the CLI's staging directory, which the CLI moves into place."""
+    if not job.get("format"):
+        return None
+    from .precomputed import _Frame
+    geometry = (job["spacing"], job["origin"], job["direction"])  # engine axes x, y, z
+    lods = int(job["lods"])
+    linear, offset = _surftrack.cli_precomputed_frame(*geometry, float(job["nanometres"]), lods > 0)
+    frame = _Frame([list(r) for r in linear], list(offset), np.ones(3), lods, int(job["quantization_bits"]),
+                   1 if job["sharded"] else 0)
+    return {"frame": frame, "cli_geometry": geometry, "staging": job["staging"], "target": None,
+            "names": {int(L): n for L, n in job["names"].items()}}
+
+
 def run(job: dict) -> list:
     source = StoreArray(job["store"], job["level"], job["channel"], job["time"])
     # The CLI's frame: engine axis e (x, y, z) is array axis 2 - e; the merge takes its geometry
@@ -59,7 +76,8 @@ def run(job: dict) -> list:
         step = max(1, total // 20)
         if not quiet and (done == total or done - last.get(stage, 0) >= step):
             last[stage] = done
-            what = {"blocks": "blocks meshed", "labels": "labels merged", "merge": "merged"}[stage]
+            what = {"blocks": "blocks meshed", "labels": "labels merged", "merge": "merged",
+                    "shards": "shards written"}[stage]
             command = "labels" if job["kind"] == "labels" else "mesh"
             print(f"surftrack {command}: {what} {done} of {total}", file=sys.stderr, flush=True)
 
@@ -73,9 +91,11 @@ def run(job: dict) -> list:
                 return distributed._run_threshold(source, job["iso"], mapping=job["mapping"], epsilon=1e-3,
                                                   figures=True, out_path=job["output"], binary=job["binary"],
                                                   **common)
+            precomputed = _precomputed(job)
             return distributed._run(source, background=int(job["background"]), figures=True,
-                                    out_dir=job["staging"], shards=None,
-                                    naming={"names": job["names"], "binary": job["binary"]}, **common)
+                                    out_dir=None if precomputed else job["staging"], shards=None,
+                                    naming={"names": job["names"], "binary": job["binary"]},
+                                    precomputed=precomputed, **common)
     finally:
         client.close()
         if cluster is not None:

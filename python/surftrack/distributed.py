@@ -14,19 +14,27 @@ as numpy is — and writes one fragment file; a block whose file exists is not c
 a stopped run resumes), one plan task, one task per shard of labels (reads its labels' fragments
 from the files, merges, writes or returns). Fragments go through the file system, never through
 the scheduler: ``work_dir`` must be shared by every worker.
+
+In Neuroglancer's formats (docs/python.md, "Neuroglancer output on Dask"), the reduce tasks
+encode each label with the single pass' C++ encoders (write_precomputed's), then, sharded, one
+task per Neuroglancer shard assembles its file, and a final task writes ``info`` and moves the
+staging directory into place.
 """
 from __future__ import annotations
 
 import itertools
 import os
+import shutil
 import tempfile
 import uuid
 import zlib
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from . import _surftrack
+from .precomputed import _frame, _stored
 
 _IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
@@ -149,23 +157,28 @@ def _file_name(label, naming):
     return f"{label}_{name.replace('/', '_').replace(' ', '_').replace(chr(92), '_')}.ply"
 
 
-def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None):
+def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, naming=None, encoding=None):
     """Task: every label of a shard merged; written into `out_dir` (named by _file_name) when it
-    is given (the files only, returned as figures), else the surfaces' fields returned."""
+    is given (the files only, returned as figures), else the surfaces' fields returned. With
+    `encoding` (_Encoding), each label encoded in Neuroglancer's format instead (_EncodedLabels)."""
     from . import Surface
     out = {}
     fragments = _shard_fragments(shard)
+    encoded = _EncodedLabels(encoding) if encoding else None
     for label, paths in shard:
         fields = _merge_label(label, [fragments.pop((label, p)) for p in paths], geometry, background,
                               adjacency, figures)
-        if out_dir is None:  # plain arrays through the scheduler (the C++ result does not pickle)
+        if out_dir is None and encoding is None:  # plain arrays through the scheduler (the C++ result does not pickle)
             result = fields.pop("result")
             fields["surfels"], fields["normals"] = result.surfels(), result.normals()
             out[label] = fields
             continue
         surface = Surface(**fields)
-        file = _file_name(label, naming)
-        surface.write(str(Path(out_dir) / file), binary=naming["binary"] if naming else True)
+        if encoding is not None:
+            file = encoded.add(label, surface)
+        else:
+            file = _file_name(label, naming)
+            surface.write(str(Path(out_dir) / file), binary=naming["binary"] if naming else True)
         area = volume = 0.0
         for c in surface.components:  # summed in the order the command line's table sums them
             area += c["area"]
@@ -173,7 +186,97 @@ def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, nami
         out[label] = {"voxels": fields["voxels"], "vertices": len(surface.vertices),
                       "triangles": len(surface.faces), "euler": fields["euler"],
                       "boundaries": len(surface.components), "area": area, "volume": volume, "file": file}
+    if encoded is not None:
+        return {"labels": out, "blobs": encoded.close()}
     return out
+
+
+class _Encoding(NamedTuple):
+    """What a reduce task needs to encode its labels as write_precomputed does: the frame
+    (precomputed._frame: the map to nanometres, the vertices' divisor, the format), the command
+    line's geometry (its multi-resolution format stores voxel indices, converter/PrecomputedFrame.h;
+    None from Python), the labels' count (the sharded layout depends on it), the staging
+    directory (unsharded: the files go there) and the work directory (sharded: the blobs)."""
+    frame: object
+    cli_geometry: object
+    count: int
+    staging: str
+    work_dir: str
+    run: str
+
+
+class _EncodedLabels:
+    """A reduce task's labels encoded by the single pass' C++ encoder (one label at a time, the
+    surface dropped after): unsharded, each label's two files written into the staging
+    directory; sharded, the encoded bytes gathered by Neuroglancer shard into one blob file per
+    shard and task in the work directory, which the shard's task reads (_write_shard)."""
+
+    def __init__(self, encoding):
+        self.e = encoding
+        self.shards = {}  # shard -> [(label, manifest, data)]
+
+    def add(self, label, surface):
+        f = self.e.frame
+        vertices, faces = _stored(surface, f)
+        manifest, data = _surftrack.encode_precomputed_segment(label, vertices, faces, f.linear, f.offset, f.lods,
+                                                               f.quantization_bits, self.e.cli_geometry)
+        if f.hashing:
+            shard = _surftrack.precomputed_shards([label], f.hashing, self.e.count)[0]
+            self.shards.setdefault(shard, []).append((label, manifest, data))
+            return ""
+        staging = Path(self.e.staging)
+        names = (f"{label}:0", f"{label}.mesh") if f.lods == 0 else (f"{label}.index", f"{label}")
+        (staging / names[0]).write_bytes(manifest)
+        (staging / names[1]).write_bytes(data)
+        return names[0]
+
+    def close(self):
+        """{shard: blob file} of what this task encoded (sharded; {} unsharded)."""
+        out = {}
+        for shard, items in self.shards.items():
+            path = Path(self.e.work_dir) / f"ng_{self.e.run}_{shard}_{uuid.uuid4().hex}.npz"
+            temporary = path.with_name(f".{path.name}.npz")
+            np.savez(temporary, labels=np.array([str(L) for L, _, _ in items]),
+                     manifests=np.array([len(m) for _, m, _ in items], dtype=np.int64),
+                     datas=np.array([len(d) for _, _, d in items], dtype=np.int64),
+                     bytes=np.frombuffer(b"".join(m + d for _, m, d in items), dtype=np.uint8))
+            os.replace(temporary, path)
+            out[shard] = str(path)
+        return out
+
+
+def _write_shard(paths, hashing, count, staging):
+    """Task: one Neuroglancer shard file assembled by the single pass' shard writer from the
+    blobs of the labels hashed to it (every reduce task's blob file of that shard)."""
+    items = []
+    for path in paths:
+        with np.load(path) as f:
+            labels, manifests, datas, raw = f["labels"], f["manifests"], f["datas"], f["bytes"].tobytes()
+        at = 0
+        for L, m, d in zip(labels, manifests, datas):
+            items.append((int(L), raw[at:at + m], raw[at + m:at + m + d]))
+            at += int(m) + int(d)
+    files = _surftrack.build_precomputed_shard(items, hashing, count)
+    for name, data in files:
+        (Path(staging) / name).write_bytes(data)
+    return [name for name, _ in files]
+
+
+def _finish_precomputed(_done, frame, labels, names, staging, target):
+    """Task: `info` and `segment_properties/info` written (after every label's and shard's file,
+    which `_done` holds back the task for), then the staging directory moved into place when
+    `target` is given (the command line moves it itself, cli/DaskLabels.cpp)."""
+    named = any(names.get(L, "") for L in labels)
+    info = _surftrack.precomputed_info(frame.linear, frame.offset, frame.lods, frame.quantization_bits,
+                                       frame.hashing, len(labels), named)
+    Path(staging, "info").write_bytes(info)
+    if named:
+        Path(staging, "segment_properties").mkdir()
+        Path(staging, "segment_properties", "info").write_bytes(
+            _surftrack.segment_properties([(L, str(names.get(L, ""))) for L in labels]))
+    if target is not None:
+        os.replace(staging, target)  # replaces an empty directory
+    return True
 
 
 class _Cluster:
@@ -227,7 +330,7 @@ def _map_blocks(client, task, source, blocks, args, progress):
 
 
 def _run(source, *, block, spacing, origin, direction, background, adjacency, figures, client, workers,
-         work_dir, out_dir, shards, progress, naming=None):
+         work_dir, out_dir, shards, progress, naming=None, precomputed=None):
     from dask.distributed import as_completed
     from . import _geometry
 
@@ -242,16 +345,48 @@ def _run(source, *, block, spacing, origin, direction, background, adjacency, fi
                               progress)
         plan = client.submit(_plan, futures, shards or max(1, 2 * len(client.scheduler_info()["workers"])), pure=False)
         shard_list = plan.result()
+        encoding = None
+        if precomputed is not None:
+            labels = sorted(L for s in shard_list for L, _ in s)
+            for L in labels:  # as the single pass' writer refuses them, before the merge
+                if L <= 0:
+                    raise ValueError(f"segment id {L} cannot be written: Neuroglancer's segment ids are positive "
+                                     "uint64 values")
+            encoding = _Encoding(precomputed["frame"], precomputed.get("cli_geometry"), len(labels),
+                                 precomputed["staging"], work_dir, run)
         reduced = [client.submit(_reduce_shard, s, geometry, background, adjacency, figures, out_dir, naming,
-                                 pure=False) for s in shard_list]
-        out, merged, total = {}, 0, sum(len(s) for s in shard_list)
+                                 encoding, pure=False) for s in shard_list]
+        out, merged, total, blobs = {}, 0, sum(len(s) for s in shard_list), {}
         for future in as_completed(reduced):
             part = future.result()
+            if encoding is not None:
+                for shard, path in part["blobs"].items():
+                    blobs.setdefault(shard, []).append(path)
+                part = part["labels"]
             out.update(part)
             merged += len(part)
             if progress:
                 progress("labels", merged, total)
+        if encoding is not None:
+            _write_precomputed_files(client, encoding, blobs, labels, precomputed, progress)
         return out
+
+
+def _write_precomputed_files(client, encoding, blobs, labels, precomputed, progress):
+    """The sharded layout's shard files (one task per Neuroglancer shard, from the reduce tasks'
+    blobs), then the final task (info, segment properties, the move into place)."""
+    from dask.distributed import as_completed
+    frame = encoding.frame
+    written = [client.submit(_write_shard, sorted(paths), frame.hashing, encoding.count, encoding.staging,
+                             pure=False) for shard, paths in sorted(blobs.items())]
+    for done, _ in enumerate(as_completed(written), 1):
+        if progress:
+            progress("shards", done, len(written))
+    final = client.submit(_finish_precomputed, written, frame, labels, precomputed.get("names") or {},
+                          encoding.staging, precomputed.get("target"), pure=False)
+    final.result()
+    for path in (p for paths in blobs.values() for p in paths):  # the shards are written: the blobs are spent
+        Path(path).unlink(missing_ok=True)
 
 
 def _require_memory(client, block, itemsize):
@@ -288,29 +423,63 @@ def label_surfaces(labels, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0), or
 
 def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0),
                        origin=(0.0, 0.0, 0.0), direction=None, background=0, adjacency="26-6", client=None,
-                       workers=None, work_dir=None, shards=None, progress=None) -> dict:
-    """Every label's surface written as ``out_dir/label_<L>.ply`` by the reduce tasks, each file
-    byte-identical to ``surftrack.label_surfaces(labels, ...)[L].write(...)`` on the whole array.
-    ``out_dir`` (shared by the workers) must not exist or be empty; it appears whole at the end
-    or not at all. Returns label -> figures (voxels, vertices, triangles, euler)."""
+                       workers=None, work_dir=None, shards=None, progress=None, format="ply", axes=None,
+                       unit="nm", names=None, lods=None, sharded=False, quantization_bits=16) -> dict:
+    """Every label's surface written into ``out_dir`` by the reduce tasks. ``format="ply"``: one
+    file ``label_<L>.ply`` a label, each byte-identical to ``surftrack.label_surfaces(labels,
+    ...)[L].write(...)`` on the whole array. ``format="precomputed"`` or
+    ``"precomputed-multires"``: Neuroglancer's directory, every file byte-identical to
+    ``surftrack.write_precomputed(surftrack.label_surfaces(labels, ...), out_dir, axes=axes,
+    unit=unit, spacing=spacing, names=names, lods=lods, sharded=sharded,
+    quantization_bits=quantization_bits)`` (``lods`` 3 by default for the multi-resolution
+    format; ``axes`` required). ``out_dir`` (shared by the workers) must not exist or be empty;
+    it appears whole at the end or not at all. Returns label -> figures (voxels, vertices,
+    triangles, euler, boundaries, area, volume, file). ``progress`` stages: "blocks", "labels",
+    and "shards" for a sharded layout."""
     target = Path(out_dir)
+    precomputed = _precomputed_job(format, axes=axes, unit=unit, spacing=spacing, names=names, lods=lods,
+                                   sharded=sharded, quantization_bits=quantization_bits)
     if target.exists() and (not target.is_dir() or any(target.iterdir())):
         raise ValueError(f"cannot write into '{out_dir}': it exists and is not an empty directory")
     staging = target.parent / f".{target.name}.tmp-{uuid.uuid4().hex}"
     staging.mkdir(parents=True)
     try:
         with _work_dir(work_dir) as work:
+            if precomputed is not None:
+                precomputed.update(staging=str(staging), target=str(target))
             figures = _run(labels, block=block, spacing=spacing, origin=origin, direction=direction,
                            background=background, adjacency=adjacency, figures=True, client=client,
-                           workers=workers, work_dir=work, out_dir=str(staging), shards=shards,
-                           progress=progress)
-        os.replace(staging, target)  # replaces an empty directory
+                           workers=workers, work_dir=work, out_dir=None if precomputed else str(staging),
+                           shards=shards, progress=progress, precomputed=precomputed)
+        if precomputed is None:
+            os.replace(staging, target)  # replaces an empty directory
     except BaseException:
-        for f in staging.glob("*"):
-            f.unlink()
-        staging.rmdir()
+        shutil.rmtree(staging, ignore_errors=True)
         raise
     return dict(sorted(figures.items()))
+
+
+_FORMATS = ("ply", "precomputed", "precomputed-multires")
+
+
+def _precomputed_job(format, *, axes, unit, spacing, names, lods, sharded, quantization_bits):
+    """write_label_meshes' format arguments checked before any work: None for PLY files, else
+    what _run's `precomputed` takes (the frame, the names)."""
+    if format not in _FORMATS:
+        raise ValueError(f"unknown format {format!r}: expected " + ", ".join(repr(f) for f in _FORMATS))
+    multires = format == "precomputed-multires"
+    if format == "ply":
+        if (axes, names, lods, sharded, quantization_bits, unit) != (None, None, None, False, 16, "nm"):
+            raise ValueError("axes, unit, names, lods, sharded and quantization_bits are for format='precomputed' "
+                             "or 'precomputed-multires'")
+        return None
+    if not multires and (lods is not None or sharded or quantization_bits != 16):
+        raise ValueError("lods, sharded and quantization_bits are for format='precomputed-multires'")
+    if axes is None:
+        raise ValueError("Neuroglancer output needs axes='zyx' (an array indexed [z, y, x]) or 'xyz'")
+    frame = _frame(axes=axes, unit=unit, spacing=spacing, lods=(3 if lods is None else lods) if multires else None,
+                   sharded=sharded, quantization_bits=quantization_bits)
+    return {"frame": frame, "names": {int(L): str(n) for L, n in (names or {}).items()}}
 
 
 def _threshold_block(source, lo, hi, shape, level, adjacency, mapping, epsilon, work_dir, run):

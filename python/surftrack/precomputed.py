@@ -7,6 +7,7 @@ the CLI's (``surftrack labels --format precomputed`` / ``precomputed-multires``)
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -41,6 +42,38 @@ def write_precomputed(surfaces: dict, path, *, axes: str, unit: str = "nm", spac
     Raises ValueError for a label that is not a positive uint64, coordinates beyond float32
     nanometres, a multi-resolution option out of range or a surface that is not closed;
     OSError when the directory cannot be written."""
+    frame = _frame(axes=axes, unit=unit, spacing=spacing, lods=lods, sharded=sharded,
+                   quantization_bits=quantization_bits)
+    names = names or {}
+    segments = []
+    for label, surface in surfaces.items():
+        if isinstance(label, bool) or not isinstance(label, (int, np.integer)):
+            raise TypeError(f"a segment id is an integer, not {label!r}")
+        segments.append((int(label), *_stored(surface, frame), str(names.get(label, ""))))
+    _surftrack.write_precomputed(segments, str(path), frame.linear, frame.offset, frame.lods,
+                                 frame.quantization_bits, frame.hashing)
+
+
+class _Frame(NamedTuple):
+    """What write_precomputed's arguments make of every segment: the map to nanometres, the
+    divisor of the vertices (the multi-resolution format stores voxel units), the format."""
+    linear: list
+    offset: list
+    scale: np.ndarray
+    lods: int  # 0: the legacy format
+    quantization_bits: int
+    hashing: int  # 0 unsharded, 1 murmurhash3_x86_128, 2 identity
+
+
+def _stored(surface, frame):
+    """A surface's (vertices, faces) as the writer takes them."""
+    return (np.asarray(surface.vertices, dtype=np.float64) / frame.scale,
+            np.asarray(surface.faces, dtype=np.int64))
+
+
+def _frame(*, axes, unit, spacing, lods, sharded, quantization_bits) -> _Frame:
+    """write_precomputed's arguments checked (ValueError) and made into a _Frame (also what
+    distributed.write_label_meshes checks before its run)."""
     if axes not in ("xyz", "zyx"):
         raise ValueError(f"axes must be 'xyz' or 'zyx' (the vertex columns as Neuroglancer's x, y, z), not {axes!r}")
     if unit not in _UNITS:
@@ -70,12 +103,5 @@ def write_precomputed(surfaces: dict, path, *, axes: str, unit: str = "nm", spac
         scale = np.asarray(s)
     linear = [[k * scale[c] if c == order[r] else 0.0 for c in range(3)] for r in range(3)]
     offset = [k * shift[order[r]] for r in range(3)]
-    names = names or {}
-    segments = []
-    for label, surface in surfaces.items():
-        if isinstance(label, bool) or not isinstance(label, (int, np.integer)):
-            raise TypeError(f"a segment id is an integer, not {label!r}")
-        segments.append((int(label), np.asarray(surface.vertices, dtype=np.float64) / scale,
-                         np.asarray(surface.faces, dtype=np.int64), str(names.get(label, ""))))
     hashing = {False: 0, True: 1, "murmurhash3_x86_128": 1, "identity": 2}[sharded]
-    _surftrack.write_precomputed(segments, str(path), linear, offset, int(lods), int(quantization_bits), hashing)
+    return _Frame(linear, offset, scale, int(lods), int(quantization_bits), hashing)
