@@ -1,5 +1,7 @@
 #include "LabelTable.h"
 
+#include <algorithm>
+
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -21,17 +23,22 @@ std::string csvField(const std::string& text) {
 
 std::string labelTableCsv(const std::vector<LabelRow>& rows) {
   std::ostringstream out;
-  out << "label,name,voxels,voxel_volume,surfels,triangles,boundaries,euler,genus,area,volume,file\n";
-  for (const LabelRow& r : rows)
+  const bool smoothed = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.smoothed; });
+  out << "label,name,voxels,voxel_volume,surfels,triangles,boundaries,euler,genus,area,volume,"
+      << (smoothed ? "volume_before_smoothing,max_vertex_displacement," : "") << "file\n";
+  for (const LabelRow& r : rows) {
     out << r.label << ',' << csvField(r.name) << ',' << r.voxels << ',' << num(r.voxelVolume, 10) << ','
         << r.surfels << ',' << r.triangles << ',' << r.boundaries << ',' << r.euler << ',' << num(r.genus)
-        << ',' << num(r.area, 10) << ',' << num(r.volume, 10) << ',' << csvField(r.file) << '\n';
+        << ',' << num(r.area, 10) << ',' << num(r.volume, 10) << ',';
+    if (smoothed) out << num(r.volumeBeforeSmoothing, 10) << ',' << num(r.maxDisplacement, 10) << ',';
+    out << csvField(r.file) << '\n';
+  }
   return out.str();
 }
 
 nlohmann::ordered_json labelTableJson(const std::vector<LabelRow>& rows) {
   nlohmann::ordered_json table = nlohmann::ordered_json::array();
-  for (const LabelRow& r : rows)
+  for (const LabelRow& r : rows) {
     table.push_back({{"label", labelJson(r.label)},
                      {"name", r.name},
                      {"voxels", r.voxels},
@@ -44,6 +51,11 @@ nlohmann::ordered_json labelTableJson(const std::vector<LabelRow>& rows) {
                      {"area", number(r.area)},
                      {"volume", number(r.volume)},
                      {"file", r.file}});
+    if (r.smoothed) {
+      table.back()["volume_before_smoothing"] = number(r.volumeBeforeSmoothing);
+      table.back()["max_vertex_displacement"] = number(r.maxDisplacement);
+    }
+  }
   return table;
 }
 

@@ -21,6 +21,10 @@ struct LabelRow {
   double genus = 0;        ///< sum over its boundaries of (2 - chi) / 2
   double area = 0, volume = 0;  ///< physical: area and volume enclosed by the mesh
   std::string file;        ///< its mesh file ("" in one PLY)
+  /// --smooth (shared walls): the enclosed volume before the smoothing and the largest vertex
+  /// move, physical units; the table has their columns only when some row is smoothed.
+  bool smoothed = false;
+  double volumeBeforeSmoothing = 0, maxDisplacement = 0;
 };
 
 /// The table as CSV: a header line, then one line per row (a field with a comma or a quote is

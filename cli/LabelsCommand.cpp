@@ -141,6 +141,12 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
   options.pair = o.pair;
   options.walls = o.walls == "shared" ? LabelWalls::Shared : LabelWalls::Independent;
   options.threads = o.threads;
+  if (o.smoothIterations > 0) {  // the complex's smoothing (docs/theory.md §12)
+    SmoothOptions so;
+    so.iterations = o.smoothIterations;
+    so.threads = o.threads;
+    options.smooth = so;
+  }
   const std::vector<LabelSurface> surfaces = extractLabels(view, options);
   if (!o.out.quiet)
     for (const LabelSurface& l : surfaces)
@@ -166,6 +172,11 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
     for (const ComponentFigures& c : s.components) {
       r.area += c.area;
       r.volume += c.volume;
+    }
+    if (ls.smooth) {
+      r.smoothed = true;
+      r.volumeBeforeSmoothing = ls.smooth->volumeBefore;
+      r.maxDisplacement = ls.smooth->maxDisplacement;
     }
     if (precomputed) {
       // The segment's manifest (unsharded; sharded, the shard file holds it).
@@ -225,6 +236,7 @@ int runLabels(const std::vector<std::string>& args) {
     j["names"] = namesFile;
     j["adjacency"] = toString(o.pair);
     j["walls"] = o.walls;
+    if (o.smoothIterations > 0) j["smooth_iterations"] = o.smoothIterations;
     j["labels"] = labelTableJson(rows);
     nlohmann::ordered_json t = nlohmann::ordered_json::object();
     for (const StageTiming& s : run.timings) t[s.name] = number(s.seconds);

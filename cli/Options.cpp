@@ -778,6 +778,19 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
       ->option_text("W")
       ->check(CLI::IsMember({"independent", "shared"}))
       ->group(which);
+  app.add_option("--smooth", o.smoothIterations,
+                 "with --walls shared: Taubin lambda|mu smoothing of the whole complex,\nN iterations (default " +
+                     std::to_string(kLabelSmoothIterations) +
+                     "), every vertex moved once, on its surfel's\nsegment: walls still shared, same voxels, same "
+                     "topology")
+      ->option_text("[N]")
+      ->expected(0, 1)
+      ->default_str(std::to_string(kLabelSmoothIterations))
+      ->check(explained(CLI::Range(1, kMaxSmoothIterations), [](const std::string& s) {
+        return "--smooth takes a number of iterations from 1 to " + std::to_string(kMaxSmoothIterations) +
+               ", got '" + s + "'";
+      }))
+      ->group(which);
   addDaskOptions(app, o.dask, args.block, o.workDir, "by blocks on Dask (a chunked store, -o DIR/)",
                  "the same files and table as the single pass");
   addSurfaceOptions(app, o.pair, o.ascii, o.threads,
@@ -890,6 +903,10 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   if (!o.dask.empty() && (o.largest || !o.seeds.empty() || !o.labels.empty() || o.range))
     throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest "
                      "or --seed yet");
+  if (o.smoothIterations > 0 && o.walls != "shared")
+    throw UsageError("--smooth on labels needs --walls shared: each label smoothed on its own would pull the "
+                     "vertices it shares with its neighbours apart");
+  if (o.smoothIterations > 0 && !o.dask.empty()) throw UsageError("--smooth is not made by blocks: no --dask");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
   if (!o.unit.empty() && o.format.empty()) throw UsageError("--unit is for --format precomputed or precomputed-multires");
   checkPrecomputedOptions(app, o.format, o.output);

@@ -126,6 +126,7 @@ struct LabelsOptions {
   std::vector<Voxel> seeds;                        ///< --seed x,y,z (repeatable)
   AdjacencyPair pair = AdjacencyPair::k26_6;
   std::string walls = "independent";               ///< --walls independent|shared
+  int smoothIterations = 0;                        ///< --smooth [N] (shared walls): 0 none
   int threads = 0;
   bool ascii = false;
   std::string table;  ///< --table FILE.csv | FILE.json

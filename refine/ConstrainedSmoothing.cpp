@@ -55,11 +55,15 @@ void forBlocks(std::size_t n, bool parallel, Body&& body) {
                       [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
 }
 
-}  // namespace
-
-SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfel,
-                                 const std::vector<std::array<std::uint32_t, 3>>& triangle,
-                                 const ImageGeometry& geometry, const SmoothingParameters& p) {
+/// The smoothing of both entry points (ConstrainedSmoothing.h): kComplex false for a closed,
+/// oriented 2-manifold (each vertex's one-ring in cyclic order), true for a complex of
+/// triangles, any number of them on an edge (each vertex's distinct neighbours and its
+/// triangles). Everything else, the segments, the cubes, the certificates and the fold check,
+/// is the same code (docs/theory.md §12, "Smoothing the complex").
+template <bool kComplex>
+SmoothingReport smoothImpl(std::vector<Point3>& points, const std::vector<Surfel>& surfel,
+                           const std::vector<std::array<std::uint32_t, 3>>& triangle, const ImageGeometry& geometry,
+                           const SmoothingParameters& p) {
   requireParameters(p);
   if (p.threads < 0) throw std::invalid_argument("smoothing threads " + std::to_string(p.threads) + " is negative");
   const std::size_t nv = points.size(), nf = triangle.size();
@@ -67,8 +71,14 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     throw std::invalid_argument("smoothing: " + std::to_string(surfel.size()) + " surfels for " + std::to_string(nv) +
                                 " vertices");
   // The one-rings below read each vertex's neighbours off its corners, which takes a closed,
-  // oriented 2-manifold (section 8: every continuous analog is one).
-  requireClosedOrientedManifold(nv, triangle);
+  // oriented 2-manifold (section 8: every continuous analog is one). A complex has no rings.
+  if constexpr (!kComplex) requireClosedOrientedManifold(nv, triangle);
+  else
+    for (std::size_t f = 0; f < nf; ++f)
+      for (std::uint32_t v : triangle[f])
+        if (v >= nv)
+          throw std::invalid_argument("smoothing: triangle " + std::to_string(f) + " has vertex " + std::to_string(v) +
+                                      " of " + std::to_string(nv));
   throwIfCancelled(p.cancel, "smoothing");
   SmoothingReport report;
   // Passes over the vertices in parallel (threads 0: all cores) but for a small mesh, where a
@@ -243,10 +253,32 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   for (const auto& tr : triangle)
     for (std::uint32_t v : tr) ++ringStart[v + 1];
   for (std::size_t v = 0; v < nv; ++v) ringStart[v + 1] += ringStart[v];
+  // A complex (kComplex) instead: each vertex's distinct neighbours (the umbrella Laplacian of
+  // its vertex graph) and each of its triangles as the pair (b, c) of its other vertices in
+  // orientation order (the area-weighted normal), at ringStart[v] .. ringStart[v + 1].
+  Lists neighbours;
+  std::vector<std::array<std::uint32_t, 2>> star;
+  if constexpr (kComplex) {
+    star.resize(3 * nf);
+    std::vector<std::uint32_t> next(ringStart.begin(), ringStart.end() - 1);
+    for (const auto& tr : triangle)
+      for (int j = 0; j < 3; ++j) star[next[tr[j]]++] = {tr[(j + 1) % 3], tr[(j + 2) % 3]};
+    neighbours.start.assign(nv + 1, 0);
+    std::vector<std::uint32_t> around;
+    for (std::size_t v = 0; v < nv; ++v) {
+      around.clear();
+      for (std::uint32_t k = ringStart[v]; k < ringStart[v + 1]; ++k) around.insert(around.end(), star[k].begin(), star[k].end());
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+      neighbours.items.insert(neighbours.items.end(), around.begin(), around.end());
+      neighbours.start[v + 1] = std::uint32_t(neighbours.items.size());
+    }
+  }
   // Each ring is stored closed, r_0 .. r_{k-1} r_0, at ringStart[v] + v, so that the walk over
   // its triangles has no wrap-around test.
-  std::vector<std::uint32_t> ring = hugePageVector<std::uint32_t>(3 * nf + nv);
-  {
+  std::vector<std::uint32_t> ring;
+  if constexpr (!kComplex) {
+    ring = hugePageVector<std::uint32_t>(3 * nf + nv);
     // First each corner's (next, previous) pair, in triangle order, then the chains.
     auto corner = hugePageVector<std::array<std::uint32_t, 2>>(3 * nf);
     std::vector<std::uint32_t> next(ringStart.begin(), ringStart.end() - 1);
@@ -291,7 +323,41 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
   // start, shared by its two passes (section 8). stepOf holds w / degree, to apply to the sum of
   // the neighbours' offsets.
   std::vector<Point3> stepOf = hugePageVector<Point3>(nv);
-  const bool prefetch = nv > kPrefetchPoints;
+  const bool prefetch = !kComplex && nv > kPrefetchPoints;
+  // A complex's vertex: the same step as a ring's below, with the Laplacian over its distinct
+  // neighbours and the normal summed over its triangles (b, c) as (b - v) x (c - v). Each wall
+  // triangle is once in the complex, oriented from its higher priority to its lower
+  // (converter/NestedWalls.h), so the normals of the nested walls through a vertex add up; the
+  // step n / (a . n) does not depend on the normal's sign.
+  auto complexStep = [&](std::size_t v, const Point3& xv, const Point3& axis, double factor, bool newNormals) {
+    const Point3* const xs = x.data();
+    const std::uint32_t first = neighbours.start[v], last = neighbours.start[v + 1];
+    if (first == last) {  // a vertex of no triangle stays put
+      xNext[v] = xv;
+      return;
+    }
+    Point3 sum{0, 0, 0};
+    for (std::uint32_t k = first; k < last; ++k) {
+      const Point3& r = xs[neighbours.items[k]];
+      for (int i = 0; i < 3; ++i) sum[i] += r[i] - xv[i];
+    }
+    if (newNormals) {
+      Point3 n{0, 0, 0};
+      for (std::uint32_t k = ringStart[v]; k < ringStart[v + 1]; ++k) {
+        const Point3 tn = cross(sub(xs[star[k][0]], xv), sub(xs[star[k][1]], xv));
+        for (int i = 0; i < 3; ++i) n[i] += tn[i];
+      }
+      const double nn = dot(n, n), an = dot(axis, n), inverseDegree = 1.0 / double(last - first);
+      if (an * an > kMinNormalCosine2 * nn * dot(axis, axis))
+        for (int i = 0; i < 3; ++i) stepOf[v][i] = n[i] * (inverseDegree / an);
+      else
+        for (int i = 0; i < 3; ++i) stepOf[v][i] = axis[i] * (inverseLength2Of[direction[v]] * inverseDegree);
+    }
+    const double before = t[v];
+    t[v] = std::clamp(before + factor * dot(sum, stepOf[v]), p.epsilon, 1 - p.epsilon);
+    const double dt = t[v] - before;
+    xNext[v] = {xv[0] + dt * axis[0], xv[1] + dt * axis[1], xv[2] + dt * axis[2]};
+  };
   auto move = [&](double factor, bool newNormals, std::size_t begin, std::size_t end) {
     const Point3* const xs = x.data();
     const std::uint32_t* const rs = ring.data();
@@ -305,6 +371,10 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
         for (std::size_t k = ringStart[w] + w, e = ringStart[w + 1] + w; k < e; ++k) __builtin_prefetch(&xs[rs[k]]);
       const Point3 xv = xs[v];
       const Point3& axis = physicalAxis[direction[v]];
+      if constexpr (kComplex) {
+        complexStep(v, xv, axis, factor, newNormals);
+        continue;
+      }
       const std::size_t first = ringStart[v] + v, last = ringStart[v + 1] + v;
       // The umbrella Laplacian, the mean of the neighbours minus x (summed as offsets from x),
       // and with new normals the area-weighted normal, the sum over the triangles
@@ -396,6 +466,20 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
     points[v] = q;
   }
   return report;
+}
+
+}  // namespace
+
+SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfels,
+                                 const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                                 const ImageGeometry& geometry, const SmoothingParameters& parameters) {
+  return smoothImpl<false>(points, surfels, triangles, geometry, parameters);
+}
+
+SmoothingReport smoothComplexOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfels,
+                                        const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                                        const ImageGeometry& geometry, const SmoothingParameters& parameters) {
+  return smoothImpl<true>(points, surfels, triangles, geometry, parameters);
 }
 
 }  // namespace surftrack::refine

@@ -53,4 +53,18 @@ SmoothingReport smoothOnSegments(std::vector<Point3>& points, const std::vector<
                                  const std::vector<std::array<std::uint32_t, 3>>& triangles,
                                  const ImageGeometry& geometry, const SmoothingParameters& parameters = {});
 
+/// The same smoothing on a conforming complex (docs/theory.md §12, "Smoothing the complex"):
+/// `triangles` are the walls of a label map, each once, on the shared vertices `points` and
+/// `surfels` (every vertex a surfel between two labels, one vertex per surfel). The vertex graph
+/// is the triangles' (the umbrella Laplacian over a vertex's distinct neighbours, the normal
+/// summed over its triangles), and the fold check tests every cube's walls together, whichever
+/// labels they separate; any number of triangles may share an edge. The segments, the clamp,
+/// the certificates and the fold check are smoothOnSegments'.
+/// \pre every triangle has its vertices on edges of one digital 3-cube, and the walls of a cube
+///      meet only in what they share (converter/NestedWalls.h).
+/// \throw as smoothOnSegments, but for the manifold check.
+SmoothingReport smoothComplexOnSegments(std::vector<Point3>& points, const std::vector<Surfel>& surfels,
+                                        const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                                        const ImageGeometry& geometry, const SmoothingParameters& parameters = {});
+
 }  // namespace surftrack::refine

@@ -80,6 +80,7 @@ std::vector<LabelFragment> scanLabelBlock(const VolumeView& view, Voxel origin, 
     throw InvalidInput("a block scan meshes every boundary: seeds select boundaries of the whole volume");
   if (options.walls != LabelWalls::Independent)
     throw InvalidInput("a block scan gives independent walls only: shared walls are not split into blocks yet");
+  if (options.smooth) throw InvalidInput("a block scan does not smooth: smoothing needs the whole complex (shared walls)");
   if (options.boundaries != LabelBoundaries::All)
     throw InvalidInput("a block scan meshes every boundary: the largest is a property of the whole volume");
   makeViewSource(view);  // checks the view

@@ -216,6 +216,9 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
   const bool fromSeeds = !o.seeds.empty();
   if (fromSeeds && o.boundaries == LabelBoundaries::Largest)
     throw InvalidInput("seeds select their own boundaries: give seeds or the largest boundary, not both");
+  if (o.smooth && o.walls != LabelWalls::Shared)
+    throw InvalidInput("smoothing a label map needs shared walls: each label smoothed on its own would pull the "
+                       "vertices it shares with its neighbours apart (docs/theory.md §12)");
   if (o.walls == LabelWalls::Shared) {
     if (fromSeeds || o.boundaries != LabelBoundaries::All)
       throw InvalidInput("shared walls partition the whole image: every boundary of every label, no seeds or largest");

@@ -11,6 +11,7 @@
 #include "ConstrainedSmoothing.h"
 #include "PhysicalRange.h"
 #include "PlaceSurface.h"
+#include "SmoothingParameters.h"
 #include "SurfaceMesh.h"
 #include "TopologySafeDecimation.h"
 
@@ -96,17 +97,8 @@ void requireSegmentsInRange(const Surface& surface) {
 }  // namespace
 
 SmoothReport smooth(Surface& surface, const SmoothOptions& o) {
-  if (o.iterations > kMaxSmoothIterations)
-    throw InvalidInput("smoothing iterations " + std::to_string(o.iterations) + " is above the limit of " +
-                       std::to_string(kMaxSmoothIterations));
+  const refine::SmoothingParameters p = smoothingParameters(o);
   requireSegmentsInRange(surface);
-  refine::SmoothingParameters p;
-  p.iterations = o.iterations;
-  p.lambda = o.lambda;
-  p.mu = o.mu;
-  p.epsilon = o.epsilon;
-  p.threads = o.threads;
-  p.cancel = o.cancel;
   SmoothReport report;
   report.volumeBefore = volumeOf(surface);
   // Smoothing moves points only: it works on the surface's arrays, with no half-edge mesh.

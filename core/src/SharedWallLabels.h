@@ -5,16 +5,21 @@
 // as it is to the one inside and reversed to the one outside. A vertex is a grid edge between
 // two voxels of different labels (a surfel), numbered per label at its first use; where a label
 // touches itself at a vertex or an edge the pinch is split (converter/PinchSplit.h) and counted.
-// One thread; the labels' meshes are the same for any `threads`.
+// With LabelOptions::smooth the scan also keeps the complex itself (every wall once, over one
+// vertex per surfel), which is smoothed as a whole (ComplexSmoothing.h); each label's vertex
+// then takes its complex vertex's point, so a vertex has one point in every label.
+// One thread for the scan; the labels' meshes are the same for any `threads`.
 #pragma once
 
 #include <algorithm>
 #include <cstdint>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "BoundaryMapping.h"
+#include "ComplexSmoothing.h"
 #include "DigitalCube.h"
 #include "Image.h"
 #include "Labels.h"
@@ -66,25 +71,48 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     std::unordered_map<std::uint64_t, std::uint32_t> vertexOf;  // grid edge key -> vertex
     std::vector<Surfel> surfels;
     std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<std::uint32_t> complexVertex;  // with smoothing: each vertex's in the complex
+  };
+  // The complex, with smoothing only: every wall once, as the cube gives it (from its higher
+  // priority to its lower), over one vertex per grid edge, its surfel oriented from its voxel of
+  // higher priority; the walls of every label, selected or not, so that the smoothed points do
+  // not depend on the selection.
+  const bool smoothing = o.smooth.has_value();
+  struct Complex {
+    std::unordered_map<std::uint64_t, std::uint32_t> vertexOf;
+    std::vector<Surfel> surfels;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+  } complex;
+  // The vertex of cube m's edge in a vertex map keyed by grid edge, and whether it is new; a new
+  // one gets its surfel from its low voxel where fromLow(priority low, priority high) says so,
+  // else from its high voxel.
+  auto vertexOfEdge = [&](std::unordered_map<std::uint64_t, std::uint32_t>& vertexOf, std::vector<Surfel>& surfels,
+                          const Voxel& m, int edge, auto&& fromLow) {
+    const Voxel lo = m + cube::cornerOffset(cube::edgeLowCorner(edge));
+    const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
+    const int axis = cube::edgeAxis(edge);
+    const auto [it, added] = vertexOf.try_emplace(Surfel{lo, directionOf(axis, +1)}.key(), std::uint32_t(surfels.size()));
+    if (added)
+      surfels.push_back(fromLow(priorityAt(lo), priorityAt(hi)) ? Surfel{lo, directionOf(axis, +1)}
+                                                                : Surfel{hi, directionOf(axis, -1)});
+    return std::pair<std::uint32_t, bool>{it->second, added};
+  };
+  auto complexVertex = [&](const Voxel& m, int edge) {
+    return vertexOfEdge(complex.vertexOf, complex.surfels, m, edge,
+                        [](std::uint32_t pl, std::uint32_t ph) { return pl > ph; }).first;
   };
   std::vector<int> slot(labels.size() + 1, -1);  // priority -> index into building, -1 if not selected
   std::vector<Building> building(selected.size());
   for (std::size_t k = 0; k < selected.size(); ++k) slot[selected[k] + 1] = int(k);
   std::unordered_map<std::uint32_t, CubeWalls> cache;  // by the corners' local ranks, 3 bits each
   auto vertex = [&](Building& b, std::uint32_t label, const Voxel& m, int edge) {
-    const Voxel lo = m + cube::cornerOffset(cube::edgeLowCorner(edge));
-    const int axis = cube::edgeAxis(edge);
-    const std::uint64_t key = Surfel{lo, directionOf(axis, +1)}.key();
-    const auto [it, added] = b.vertexOf.try_emplace(key, std::uint32_t(b.surfels.size()));
-    if (added) {
-      // The label's own surfel has its voxel inside; a vertex of two other labels (a junction)
-      // is oriented from the one of higher priority.
-      const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
-      const std::uint32_t pl = priorityAt(lo), ph = priorityAt(hi);
-      const bool fromLow = pl == label || (ph != label && pl > ph);
-      b.surfels.push_back(fromLow ? Surfel{lo, directionOf(axis, +1)} : Surfel{hi, directionOf(axis, -1)});
-    }
-    return it->second;
+    // The label's own surfel has its voxel inside; a vertex of two other labels (a junction) is
+    // oriented from the one of higher priority.
+    const auto [v, added] = vertexOfEdge(b.vertexOf, b.surfels, m, edge, [&](std::uint32_t pl, std::uint32_t ph) {
+      return pl == label || (ph != label && pl > ph);
+    });
+    if (added && smoothing) b.complexVertex.push_back(complexVertex(m, edge));
+    return v;
   };
   for (int z = -1; z < dims.nz; ++z)
     for (int y = -1; y < dims.ny; ++y)
@@ -107,6 +135,9 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
         const CubeWalls& walls = at->second;
         for (int w = 0; w < walls.count; ++w) {
           const WallTriangle& t = walls.triangles[std::size_t(w)];
+          if (smoothing)
+            complex.triangles.push_back(
+                {complexVertex(m, t.edges[0]), complexVertex(m, t.edges[1]), complexVertex(m, t.edges[2])});
           for (const bool reversed : {false, true}) {
             const std::uint32_t label = distinct[reversed ? t.outside : t.inside];
             if (slot[label] < 0) continue;
@@ -119,9 +150,20 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
         }
       }
 
-  // 3. Pinches split, vertices placed (midpoint mapping, then the geometry), figures.
+  // 3. With smoothing, the complex smoothed from the midpoint mapping (then the geometry).
   const ImageGeometry geometry = source.geometry();
   const bool mirrored = geometry.handedness() < 0;
+  std::vector<refine::Point3> smoothed;
+  SmoothReport complexReport;
+  if (smoothing) {
+    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+    smoothed.resize(complex.surfels.size());
+    for (std::size_t v = 0; v < smoothed.size(); ++v) smoothed[v] = geometry.toPhysical(MidpointMapping{}(complex.surfels[v]));
+    complexReport = smoothComplex(smoothed, complex.surfels, complex.triangles, geometry, *o.smooth, o.cancel);
+  }
+
+  // 4. Pinches split, vertices placed (midpoint mapping, then the geometry, or the smoothed
+  //    complex's points), figures.
   std::vector<LabelSurface> out;
   out.reserve(selected.size());
   for (std::size_t k = 0; k < selected.size(); ++k) {
@@ -147,6 +189,19 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     s.vertices.resize(s.surfels.size());
     for (std::size_t v = 0; v < s.surfels.size(); ++v) s.vertices[v] = geometry.toPhysical(MidpointMapping{}(s.surfels[v]));
     requirePlacedVertices(geometry, s.vertices, [&](std::size_t v) { return MidpointMapping{}(s.surfels[v]); });
+    if (smoothing) {
+      // A copy of a pinch is its original's complex vertex: the copies move together.
+      SmoothReport report = complexReport;
+      for (const ComponentFigures& c : componentFigures(s.vertices, s.triangles)) report.volumeBefore += c.volume;
+      if (mirrored) report.volumeBefore = -report.volumeBefore;  // (finishScannedLabel turns the triangles)
+      const std::size_t originals = s.surfels.size() - split.copyOf.size();
+      for (std::size_t v = 0; v < s.vertices.size(); ++v) {
+        const std::uint32_t c = b.complexVertex[v < originals ? v : split.copyOf[v - originals]];
+        report.maxDisplacement = std::max(report.maxDisplacement, refine::norm(refine::sub(smoothed[c], s.vertices[v])));
+        s.vertices[v] = smoothed[c];
+      }
+      result.smooth = report;
+    }
     result.pinchCopies = split.copyOf.size();
     result.pinchedEdges = split.pinchedEdges;
     result.unsplitEdges = split.unsplitEdges;
@@ -156,6 +211,14 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
                            std::to_string(split.unsplitEdges) +
                            " of them left with four triangles (docs/theory.md §12, pinches)");
     finishScannedLabel(s, mirrored, o);
+    if (smoothing) {
+      double after = 0;
+      if (o.figures)
+        for (const ComponentFigures& c : s.components) after += c.volume;
+      else
+        for (const ComponentFigures& c : componentFigures(s.vertices, s.triangles)) after += c.volume;
+      result.smooth->volumeAfter = after;
+    }
   }
   return out;
 }

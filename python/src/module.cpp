@@ -417,9 +417,15 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
                             const std::string& boundaries, std::vector<std::array<int, 3>> seeds,
                             const std::string& adjacency, std::array<double, 3> spacing,
                             std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
-                            int threads, bool figures, const std::string& walls) {
+                            int threads, bool figures, const std::string& walls, int smoothIterations) {
   const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
   LabelOptions o;
+  if (smoothIterations > 0) {  // the complex's smoothing (docs/theory.md §12), shared walls only
+    SmoothOptions so;
+    so.iterations = smoothIterations;
+    so.threads = threads;
+    o.smooth = so;
+  }
   if (walls != "independent" && walls != "shared")
     throw InvalidInput("unknown walls '" + walls + "': expected 'independent' or 'shared'");
   o.walls = walls == "shared" ? LabelWalls::Shared : LabelWalls::Independent;
@@ -451,6 +457,16 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
     r->surface = std::move(ls.surface);
     py::dict d = surfaceDict(r);
     d["voxels"] = ls.voxels;
+    if (const auto& smoothed = ls.smooth) {  // as extract()'s "refine", this label's figures
+      py::dict summary;
+      summary["smooth_iterations"] = smoothed->iterations;
+      summary["max_vertex_displacement"] = smoothed->maxDisplacement;
+      summary["steps_back"] = smoothed->stepsBack;
+      summary["unguarded_cubes"] = smoothed->unguardedCubes;
+      summary["volume_before"] = smoothed->volumeBefore;
+      summary["volume_after"] = smoothed->volumeAfter;
+      d["refine"] = summary;
+    }
     out[labelObject(ls.label)] = d;
   }
   return out;

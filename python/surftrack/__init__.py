@@ -407,7 +407,7 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
                    background: int = 0, boundaries: str = "all", seeds: Optional[Sequence] = None,
                    adjacency: str = "26-6", spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
                    direction=None, affine=None, threads: int = 0, figures: bool = True,
-                   walls: str = "independent") -> dict:
+                   walls: str = "independent", smooth: int = 0) -> dict:
     """Every label of an integer label image as a closed surface: a dict label -> Surface.
 
     One scan of the cubes triangulates every boundary of every label at once ("largest" and
@@ -421,7 +421,11 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     ``extract``. ``walls="shared"`` makes all the labels one conforming complex (every wall one
     set of triangles used by both its labels, space partitioned exactly; docs/theory.md, "Shared
     walls"; every boundary only: no seeds, not "largest"); "independent" (default) meshes each
-    label against the rest.
+    label against the rest. ``smooth=N`` (shared walls only) smooths the whole complex with
+    N Taubin iterations as ``extract``'s smooth does one surface: every vertex moves once, to the
+    same point in every label, along its surfel's segment, so each wall stays shared, space stays
+    partitioned and each label keeps its voxels and topology (docs/theory.md §12, "Smoothing the
+    complex"; each Surface's ``refine`` holds its volume before and after and its largest move).
     Raises ValueError (surftrack.InvalidInput) / TypeError on bad input.
     """
     array = _as_volume(labels)
@@ -440,6 +444,14 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
                          + ", ".join(_ADJACENCIES))
     if walls not in ("independent", "shared"):
         raise ValueError(f"unknown walls '{walls}': expected 'independent' or 'shared'")
+    if isinstance(smooth, bool) or int(smooth) != smooth or smooth < 0:
+        raise ValueError(f"smooth takes a number of iterations >= 0, not {smooth!r}")
+    if smooth > _surftrack.MAX_SMOOTH_ITERATIONS:
+        raise ValueError(f"smooth takes at most {_surftrack.MAX_SMOOTH_ITERATIONS} iterations "
+                         f"(as the CLI's --smooth), not {smooth!r}")
+    if smooth and walls != "shared":
+        raise ValueError("smooth= on a label map needs walls='shared': each label smoothed on its own "
+                         "would pull the vertices it shares with its neighbours apart")
     # Labels reach the engine as Python ints (tolist() turns numpy integers into ints), never
     # through float: uint64 segment ids above 2^53 stay exact.
     kind, values, bounds = "all", [], []
@@ -465,7 +477,8 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
         array = np.ascontiguousarray(array)
     out = _surftrack.label_surfaces_array(array, [2, 1, 0], kind, values, bounds, background,
                                           boundaries, seed_list, adjacency, spacing, origin,
-                                          direction.tolist(), int(threads), bool(figures), walls)
+                                          direction.tolist(), int(threads), bool(figures), walls,
+                                          int(smooth))
     return {label: Surface(**fields) for label, fields in out.items()}
 
 

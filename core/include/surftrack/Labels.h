@@ -15,12 +15,14 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "AdjacencyPair.h"
 #include "Extract.h"
 #include "LabelValue.h"
+#include "Refine.h"
 #include "VolumeView.h"
 #include "Voxel.h"
 
@@ -79,6 +81,13 @@ struct LabelOptions {
   /// Independent: each label's own (kappa, lambda) surfaces. Shared: the conforming complex,
   /// each level of the priority order's analog with this pair.
   LabelWalls walls = LabelWalls::Independent;
+  /// Shared walls only: if set, the smoothing of the complex (docs/theory.md §12, "Smoothing the
+  /// complex"): smooth()'s Taubin lambda|mu passes and fold check over all the labels' walls at
+  /// once, every vertex moved once to the same point in every label that has it, on its surfel's
+  /// segment, so that the walls stay shared triangle for triangle, the regions a partition, and
+  /// each label keeps its voxels and its topology. With independent walls: refused
+  /// (InvalidInput), as each label smoothed on its own would pull the vertices it shares apart.
+  std::optional<SmoothOptions> smooth;
   /// Threads for the scan and for the labels: 0 for all cores. The surfaces are the same for any
   /// number.
   int threads = 0;
@@ -101,6 +110,10 @@ struct LabelSurface {
   /// those of them no copy separates (still of four or more triangles: the surface is a closed
   /// oriented 2-cycle but not a 2-manifold there).
   std::size_t pinchCopies = 0, pinchedEdges = 0, unsplitEdges = 0;
+  /// LabelOptions::smooth: this label's enclosed volume before and after the smoothing and its
+  /// largest vertex move (physical units); cubes, unguardedCubes, checkedCubes and stepsBack
+  /// are the whole complex's, the same in every label. Nothing without smoothing.
+  std::optional<SmoothReport> smooth;
 };
 
 /// The surfaces of the selected labels of `view`, by increasing label. Labels are exact over
