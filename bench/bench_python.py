@@ -525,27 +525,32 @@ def main(argv=None) -> int:
         print(f"  {name:<20} {what:<27} wall {1000 * wall:8.1f}{extra}, core {1000 * core:.1f} "
               f"({stages}); {components:,} components")
 
-    # The targets.
+    # The targets (docs/performance.md, "The Python front door"): marching_cubes with its default
+    # threads >= 5x scikit-image on the MRI and the clean spheres (>= 2x on the noisy 256^3 one)
+    # and no slower than VTK on one thread there; the default threads >= 1.6x one thread on the
+    # clean 512^3 sphere and the MRI, and never slower than one thread (5 % of noise allowed).
     print("\nTargets:")
     for name in dict.fromkeys(r["image"] for r in rows if not r["image"].endswith("(Fortran order)")):
         mine = [r for r in rows if r["image"] == name]
+        ours = next(r for r in mine if r["tool"].startswith("surftrack.marching_cubes (threads=0"))
+        one = next((r for r in mine if r["tool"].startswith("surftrack.marching_cubes (threads=1")), None)
         sk = next(r for r in mine if r["tool"].startswith("skimage"))
         vt = next(r for r in mine if r["tool"].startswith("vtkFlyingEdges3D"))
         ex = next(r for r in mine if r["tool"].startswith("surftrack.extract"))
-        parts = []
-        for label, key in (("default threads", "ratio"), ("1 thread", "ratio_1t")):
-            if sk[key] == "":
-                continue
-            s = f"{label}: vs skimage {1 / sk[key]:.2f}x ({'met' if 1 / sk[key] >= 10 else 'MISSED'}), " \
-                f"vs VTK {1 / vt[key]:.2f}x"
-            if name == "sphere q=512 p=0%":
-                s += f" ({'met' if vt[key] <= 1.0 else 'MISSED'})"
-            parts.append(s)
+        clean = name.startswith("MRI") or name.endswith("p=0%")
+        need = 5.0 if clean else 2.0 if name == "sphere q=256 p=5%" else None
+        speed = sk["median_s"] / ours["median_s"]
+        parts = [f"vs skimage {speed:.2f}x" + (f" (>= {need:g}x: {'met' if speed >= need else 'MISSED'})" if need else "")]
+        vtk = vt["median_s"] / ours["median_s"]
+        parts.append(f"vs VTK 1 thread {vtk:.2f}x" + (f" (>= 1: {'met' if vtk >= 1 else 'MISSED'})" if clean else ""))
+        if one is not None:
+            gain = one["median_s"] / ours["median_s"]
+            want = 1.6 if name in ("MRI ch2better", "sphere q=512 p=0%") else None
+            verdict = ("met" if gain >= want else "MISSED") if want else ("met" if gain >= 1 / 1.05 else "MISSED")
+            parts.append(f"threads=0 vs threads=1 {gain:.2f}x ({'>= 1.6' if want else 'never slower'}: {verdict})")
         ov = ex["overhead"]
         parts.append(f"Python overhead {100 * ov:+.1f} % ({'met' if ov <= 0.05 else 'MISSED'})")
         print(f"  {name:<20} " + "; ".join(parts))
-    print("  (>= 10x faster than skimage on every image; no slower than VTK on the clean 512^3 sphere; "
-          "overhead <= 5 %)")
 
     if args.csv:
         fields = ["image", "tool", "median_s", "triangles", "ratio", "ratio_1t", "reps", "runs_s"]
