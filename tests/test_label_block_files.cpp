@@ -113,8 +113,10 @@ TEST(LabelBlockFiles, FilesMergesAndTreeFiguresAreTheSinglePass) {
       ASSERT_EQ(got.surface.triangles, want.surface.triangles);
       EXPECT_EQ(got.voxels, want.voxels);
       std::uint64_t weight = 0;
-      for (const std::string& p : paths)
-        if (const auto* e = readFragmentFileIndex(p).find(want.label)) weight += 8 * e->keys + 12 * e->triangles;
+      for (const std::string& p : paths) {
+        const FragmentFileIndex index = readFragmentFileIndex(p);  // find() points into it
+        if (const auto* e = index.find(want.label)) weight += 8 * e->keys + 12 * e->triangles;
+      }
       for (const std::uint64_t budget : {std::uint64_t(0), std::uniform_int_distribution<std::uint64_t>(0, weight)(rng)}) {
         const LabelFigures f = labelFiguresByTree(want.label, paths, dims, block, geometry, o, budget);
         if (budget == 0) deepest = std::max(deepest, f.levels);
