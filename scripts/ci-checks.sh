@@ -6,7 +6,7 @@
 #                   per format for a bounded time, seeded with files written by ITK, zarr-python
 #                   and numcodecs (fuzz/run_fuzzers.sh; default 10 s per format; with
 #                   SURFTRACK_FUZZ_RUNS=N, N inputs from a fixed seed instead). CI runs this
-#                   with N = 5000 (.ci/run).
+#                   with N = 2000 (.ci/run).
 #   sanitize        the whole test suite again, in a build of its own with AddressSanitizer and
 #                   UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its
 #                   test). CI runs it last (.ci/run). Measured in CPU time (the 2-core machines
