@@ -27,6 +27,7 @@ std::vector<LabelRow> labelRowsOnDask(const LabelsOptions& o, const LabelNames& 
   job["names"] = named;
   job["binary"] = !o.ascii;
   job["quiet"] = o.out.quiet;
+  job["merge_budget"] = o.mergeBudget ? json(*o.mergeBudget) : json(nullptr);
   const bool precomputed = !o.format.empty();
   if (precomputed) {
     // The reduce tasks encode each label as the single pass' writers do (PrecomputedOutput.h),
@@ -60,6 +61,12 @@ std::vector<LabelRow> labelRowsOnDask(const LabelsOptions& o, const LabelNames& 
     if (precomputed) {  // the segment's manifest (sharded: the shard file holds it), as the single pass
       r.file = o.precomputed.sharded ? o.output
                : (fs::path(o.output) / (r.label.text() + (o.format == "precomputed" ? ":0" : ".index"))).string();
+      rows.push_back(std::move(r));
+      continue;
+    }
+    if (f.contains("levels")) r.mergeLevels = f["levels"].get<int>();  // figures from the tree (--merge-budget)
+    if (f["file"].is_null()) {  // over --merge-budget and not written: the row says so, never a silent gap
+      r.noFile = f.value("no_file", std::string("over --merge-budget: figures from a tree of blocks, no mesh"));
       rows.push_back(std::move(r));
       continue;
     }

@@ -24,14 +24,20 @@ std::string csvField(const std::string& text) {
 std::string labelTableCsv(const std::vector<LabelRow>& rows) {
   std::ostringstream out;
   const bool smoothed = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.smoothed; });
+  const bool tree = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.mergeLevels >= 0; });
+  const bool missing = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return !r.noFile.empty(); });
   out << "label,name,voxels,voxel_volume,surfels,triangles,boundaries,euler,genus,area,volume,"
-      << (smoothed ? "volume_before_smoothing,max_vertex_displacement," : "") << "file\n";
+      << (smoothed ? "volume_before_smoothing,max_vertex_displacement," : "") << "file"
+      << (tree ? ",merge_levels" : "") << (missing ? ",no_file" : "") << "\n";
   for (const LabelRow& r : rows) {
     out << r.label << ',' << csvField(r.name) << ',' << r.voxels << ',' << num(r.voxelVolume, 10) << ','
         << r.surfels << ',' << r.triangles << ',' << r.boundaries << ',' << r.euler << ',' << num(r.genus)
         << ',' << num(r.area, 10) << ',' << num(r.volume, 10) << ',';
     if (smoothed) out << num(r.volumeBeforeSmoothing, 10) << ',' << num(r.maxDisplacement, 10) << ',';
-    out << csvField(r.file) << '\n';
+    out << csvField(r.file);
+    if (tree) out << ',' << (r.mergeLevels >= 0 ? std::to_string(r.mergeLevels) : std::string());
+    if (missing) out << ',' << csvField(r.noFile);
+    out << '\n';
   }
   return out.str();
 }
@@ -50,11 +56,13 @@ nlohmann::ordered_json labelTableJson(const std::vector<LabelRow>& rows) {
                      {"genus", number(r.genus)},
                      {"area", number(r.area)},
                      {"volume", number(r.volume)},
-                     {"file", r.file}});
+                     {"file", r.noFile.empty() ? nlohmann::ordered_json(r.file) : nlohmann::ordered_json()}});
     if (r.smoothed) {
       table.back()["volume_before_smoothing"] = number(r.volumeBeforeSmoothing);
       table.back()["max_vertex_displacement"] = number(r.maxDisplacement);
     }
+    if (r.mergeLevels >= 0) table.back()["merge_levels"] = r.mergeLevels;
+    if (!r.noFile.empty()) table.back()["no_file"] = r.noFile;
   }
   return table;
 }

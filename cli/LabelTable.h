@@ -25,6 +25,12 @@ struct LabelRow {
   /// move, physical units; the table has their columns only when some row is smoothed.
   bool smoothed = false;
   double volumeBeforeSmoothing = 0, maxDisplacement = 0;
+  /// --dask --merge-budget: a label over the budget has its figures from a tree of groups of
+  /// blocks of this many levels (docs/theory.md, "A label larger than one merge"; -1: merged
+  /// whole), and `noFile` says why it has no mesh file when none was written ("" when one was).
+  /// The table has the merge_levels and no_file columns only when some row needs them.
+  int mergeLevels = -1;
+  std::string noFile;
 };
 
 /// The table as CSV: a header line, then one line per row (a field with a comma or a quote is

@@ -1,5 +1,6 @@
 // `surftrack labels INPUT -o OUTPUT [options]`: extractLabels (docs/api.md, "Label maps") on a
 // volume file, the meshes written one file per label or as one PLY, with a table per label.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -119,6 +120,10 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
     if (o.walls != "independent") throw UsageError("--walls shared is not made by blocks yet: no --dask");
     run.rows = labelRowsOnDask(o, names, staged);
     clock.lap(timings, "dask");
+    const auto unwritten = std::count_if(run.rows.begin(), run.rows.end(), [](const LabelRow& r) { return !r.noFile.empty(); });
+    if (unwritten && !o.out.quiet)
+      std::cerr << "surftrack: warning: " << unwritten << " label" << (unwritten == 1 ? "" : "s")
+                << " over --merge-budget have figures but no mesh file (the table's no_file column says why)\n";
     if (!precomputed)  // a Neuroglancer directory holds its format's files only, as the single pass writes it
       writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(run.rows));
     staged.commit();

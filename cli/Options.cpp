@@ -48,6 +48,25 @@ std::optional<long long> toInteger(const std::string& text) {
 /// A label, exactly: decimal digits with an optional sign up to 64 bits (segment ids above
 /// 2^53 included), or a number that is an integer of at most 2^53 ("1e3", "5.0"), where doubles
 /// are still exact.
+/// A number of bytes: decimal digits with an optional suffix K, M or G (powers of 1024, either
+/// case, "KiB" etc. too): "536870912", "512M", "2G". None when it is not one or overflows 64 bits.
+std::optional<std::uint64_t> toByteCount(const std::string& text) {
+  std::size_t digits = 0;
+  while (digits < text.size() && text[digits] >= '0' && text[digits] <= '9') ++digits;
+  if (digits == 0) return std::nullopt;
+  std::uint64_t value = 0;
+  auto [ptr, ec] = std::from_chars(text.data(), text.data() + digits, value);
+  if (ec != std::errc()) return std::nullopt;
+  std::string suffix = text.substr(digits);
+  for (char& ch : suffix) ch = char(std::toupper(static_cast<unsigned char>(ch)));
+  static const std::map<std::string, int> shifts = {{"", 0},   {"B", 0},    {"K", 10},   {"KB", 10}, {"KIB", 10},
+                                                    {"M", 20}, {"MB", 20},  {"MIB", 20}, {"G", 30},  {"GB", 30},
+                                                    {"GIB", 30}};
+  const auto shift = shifts.find(suffix);
+  if (shift == shifts.end() || (shift->second && value > (~std::uint64_t(0) >> shift->second))) return std::nullopt;
+  return value << shift->second;
+}
+
 std::optional<LabelValue> toLabel(const std::string& text) {
   if (auto L = LabelValue::parse(text)) return L;
   const auto v = toNumber(text);
@@ -100,6 +119,13 @@ const CLI::Validator kInteger(
       return std::string();
     },
     "INTEGER");
+
+const CLI::Validator kByteCount(
+    [](std::string& s) {
+      return toByteCount(s) ? std::string()
+                            : "'" + s + "' is not a number of bytes (digits, optionally followed by K, M or G)";
+    },
+    "BYTES");
 
 const CLI::Validator kLabel(
     [](std::string& s) {
@@ -793,6 +819,12 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
       ->group(which);
   addDaskOptions(app, o.dask, args.block, o.workDir, "by blocks on Dask (a chunked store, -o DIR/)",
                  "the same files and table as the single pass");
+  addValue(app, "--merge-budget", "B", [&o](const std::string& s) { o.mergeBudget = *toByteCount(s); },
+           "with --dask: a label whose fragments take more than B bytes (512M,\n"
+           "2G) is not merged whole: its figures come from a tree of groups of\n"
+           "blocks, its mesh is streamed (docs/cli.md)")
+      ->check(kByteCount)
+      ->group("by blocks on Dask (a chunked store, -o DIR/)");
   addSurfaceOptions(app, o.pair, o.ascii, o.threads,
                     "threads for the scan and the labels (default 0: all cores);\n"
                     "the meshes are the same for any number");
@@ -907,6 +939,10 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
     throw UsageError("--smooth on labels needs --walls shared: each label smoothed on its own would pull the "
                      "vertices it shares with its neighbours apart");
   if (o.smoothIterations > 0 && !o.dask.empty()) throw UsageError("--smooth is not made by blocks: no --dask");
+  if (o.mergeBudget && o.dask.empty()) throw UsageError("--merge-budget is for --dask (the single pass merges nothing)");
+  if (o.mergeBudget && !o.format.empty())
+    throw UsageError("--merge-budget is for mesh files: not with --format (Neuroglancer's formats hold every label's "
+                     "mesh)");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
   if (!o.unit.empty() && o.format.empty()) throw UsageError("--unit is for --format precomputed or precomputed-multires");
   checkPrecomputedOptions(app, o.format, o.output);

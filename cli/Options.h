@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -140,6 +141,9 @@ struct LabelsOptions {
   std::string dask;
   std::array<int, 3> block{256, 256, 256};  ///< --block BX,BY,BZ (with --dask)
   std::string workDir;                      ///< --work-dir DIR (with --dask): fragments kept, a run resumes
+  /// --merge-budget B (with --dask): the fragment bytes of a label merged whole at most
+  /// (surftrack.distributed.write_label_meshes' merge_budget); none: no limit.
+  std::optional<std::uint64_t> mergeBudget;
   OutputOptions out;
 };
 

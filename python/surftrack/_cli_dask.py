@@ -95,7 +95,7 @@ def run(job: dict) -> list:
             return distributed._run(source, background=int(job["background"]), figures=True,
                                     out_dir=None if precomputed else job["staging"], shards=None,
                                     naming={"names": job["names"], "binary": job["binary"]},
-                                    precomputed=precomputed, **common)
+                                    precomputed=precomputed, merge_budget=job.get("merge_budget"), **common)
     finally:
         client.close()
         if cluster is not None:

@@ -369,3 +369,72 @@ def test_cli_mesh_all_on_dask_writes_the_single_pass_file(tmp_path):
         r = run_cli("mesh", tmp_path / "v.zarr", *args, "-o", tmp_path / "c.ply", "--dask", "local:2")
         assert r.returncode != 0 and says in r.stderr and r.stderr.count("\n") == 1, r.stderr
     assert not (tmp_path / "c.ply").exists()
+
+
+def test_cli_labels_on_dask_with_a_merge_budget(tmp_path):
+    """`surftrack labels STORE -o DIR/ --dask local:2 --merge-budget B` against the CLI's single
+    pass on the same store: the labels within the budget byte for byte; those over it (the
+    fragment files' bytes, counted here from their indices, decide which) with the single pass's
+    counts exactly, area and volume within 1e-9, merge_levels in the table, and the table's row
+    saying whether a mesh file was written (never a file missing without a word)."""
+    import csv
+    import json
+    rng = np.random.default_rng(43)
+    shape = (26, 21, 23)
+    seeds = rng.integers(0, shape, size=(7, 3))
+    grid = np.stack(np.indices(shape), axis=-1).reshape(-1, 1, 3)
+    cells = np.argmin(((grid - seeds[None]) ** 2).sum(-1), axis=1).reshape(shape).astype(np.uint16) + 1
+    cells[rng.random(shape) < 0.04] = 9  # specks: a label of many components
+    zarr.open(str(tmp_path / "s.zarr"), mode="w", shape=shape, chunks=(9, 8, 7), dtype="<u2")[:] = cells
+    single = tmp_path / "single"
+    a = run_cli("labels", tmp_path / "s.zarr", "-o", f"{single}/", "--table", tmp_path / "a.json")
+    assert a.returncode == 0, a.stderr
+    work = tmp_path / "work"
+    first = run_cli("labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/first/", "--dask", "local:2", "--block",
+                    "9,8,12", "--work-dir", work)
+    assert first.returncode == 0, first.stderr
+    weight = {}
+    for path in work.iterdir():
+        for label, keys, triangles in surftrack._surftrack.fragment_file_summary(str(path)):
+            weight[label] = weight.get(label, 0) + 8 * keys + 12 * triangles
+    sizes = sorted(w // 1024 for w in weight.values())
+    kib = sizes[len(sizes) // 2]  # a budget in K that about half the labels exceed
+    over = sorted(L for L, w in weight.items() if w > kib * 1024)
+    assert 0 < len(over) < len(weight)
+    dask = tmp_path / "dask"
+    b = run_cli("labels", tmp_path / "s.zarr", "-o", f"{dask}/", "--table", tmp_path / "b.json", "--dask", "local:2",
+                "--block", "9,8,12", "--work-dir", work, "--merge-budget", f"{kib}K")
+    assert b.returncode == 0, b.stderr
+    want = {r["label"]: r for r in json.loads((tmp_path / "a.json").read_text())}
+    got = {r["label"]: r for r in json.loads((tmp_path / "b.json").read_text())}
+    assert sorted(got) == sorted(want) == sorted(weight)
+    for label, w in want.items():
+        g = got[label]
+        for column in ("voxels", "surfels", "triangles", "boundaries", "euler", "genus", "name"):
+            assert g[column] == w[column], (label, column)
+        assert g["area"] == pytest.approx(w["area"], rel=1e-9) and g["volume"] == pytest.approx(w["volume"], rel=1e-9)
+        name = Path(w["file"]).name
+        if label in over:
+            assert g["merge_levels"] >= 1 and g["file"] is None and "merge-budget" in g["no_file"]
+            assert not (dask / name).exists()
+        else:
+            assert "merge_levels" not in g and "no_file" not in g
+            assert (dask / name).read_bytes() == (single / name).read_bytes(), label
+    rows = list(csv.DictReader(open(dask / "labels.csv")))
+    assert [int(r["label"]) for r in rows] == sorted(weight)
+    assert all((r["no_file"] != "") == (int(r["label"]) in over) for r in rows)
+    assert all((r["merge_levels"] != "") == (int(r["label"]) in over) for r in rows)
+    assert f"{len(over)} label" in b.stderr and "no mesh file" in b.stderr
+
+
+def test_cli_merge_budget_bad_input(tmp_path):
+    zarr.open(str(tmp_path / "s.zarr"), mode="w", shape=(6, 6, 6), chunks=(3, 3, 3), dtype="<u2")[:] = 1
+    cases = [(["--merge-budget", "1M"], "is for --dask"),
+             (["--dask", "local:2", "--merge-budget", "12X"], "not a number of bytes"),
+             (["--dask", "local:2", "--merge-budget", "-5"], "not a number of bytes"),
+             (["--dask", "local:2", "--merge-budget", "99999999999G"], "not a number of bytes"),
+             (["--dask", "local:2", "--merge-budget", "1G", "--format", "precomputed"], "not with --format")]
+    for args, says in cases:
+        r = run_cli("labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/out/", *args)
+        assert r.returncode != 0 and says in r.stderr and r.stderr.count("\n") == 1, (args, r.stderr)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr"]
