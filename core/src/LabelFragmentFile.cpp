@@ -13,7 +13,7 @@
 
 #include "BlockOwnership.h"
 #include "Errors.h"
-#include "Hash.h"
+#include "FragmentChecksum.h"
 #include "LabelBlockFiles.h"
 
 namespace surftrack {
@@ -25,18 +25,9 @@ constexpr char kMagic[8] = {'S', 'T', 'F', 'R', 'A', 'G', '\r', '\n'};
 constexpr std::uint32_t kVersion = 1;
 constexpr std::size_t kHeaderBytes = 80, kEntryBytes = 56;
 
-/// The file's checksum: every 8 bytes mixed in turn (Hash.h), the tail zero-padded.
-std::uint64_t checksum(const void* data, std::size_t bytes, std::uint64_t h = 0x5354465241470001ull) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  std::size_t i = 0;
-  for (; i + 8 <= bytes; i += 8) {
-    std::uint64_t w;
-    std::memcpy(&w, p + i, 8);
-    h = mix64(h ^ w) + i;
-  }
-  std::uint64_t tail = 0;
-  if (bytes > i) std::memcpy(&tail, p + i, bytes - i);  // (an empty vector's data may be null)
-  return mix64(h ^ tail ^ (std::uint64_t(bytes) << 56));
+/// The file's checksum (FragmentChecksum.h).
+std::uint64_t checksum(const void* data, std::size_t bytes, std::uint64_t h = FragmentChecksum::kSeed) {
+  return fragmentChecksum(data, bytes, h);
 }
 
 template <class T>

@@ -620,6 +620,21 @@ py::dict mergeLabelFilesArrays(py::object label, const std::vector<std::string>&
   return mergedLabelDict([&] { return mergeLabelFragmentFiles(L, paths, geometry, o); }, path, binary);
 }
 
+/// writeLabelMeshStreamed: `label`'s mesh written from its fragment files to `path` (binary PLY)
+/// with bounded memory, the bytes merge_label_files writes (geometry in array axes): (vertices,
+/// triangles).
+py::tuple writeLabelMeshStreamedFile(py::object label, const std::vector<std::string>& paths,
+                                     std::array<double, 3> spacing, std::array<double, 3> origin,
+                                     std::array<std::array<double, 3>, 3> direction, const std::string& path,
+                                     std::uint64_t budget) {
+  const ImageGeometry geometry = geometryOfArrayAxes(spacing, origin, direction);
+  const LabelValue L = labelOf(label, "label");
+  LabelMeshCounts counts;
+  std::atomic<bool> cancel{false};
+  runEngine(kLastAxisFirst, cancel, [&] { counts = writeLabelMeshStreamed(L, paths, geometry, path, budget, &cancel); });
+  return py::make_tuple(counts.vertices, counts.triangles);
+}
+
 /// labelFiguresByTree: `label`'s figures from the fragment files of a grid of `block` voxels
 /// (array axes): voxels, the (K, 7) components table of surfaceDict, euler, vertices,
 /// triangles, levels, leaves.
@@ -978,6 +993,8 @@ PYBIND11_MODULE(_surftrack, m) {
         py::arg("origin"), py::arg("direction"), py::arg("background"), py::arg("adjacency"), py::arg("figures"),
         py::arg("path") = "", py::arg("binary") = true);
   m.def("label_figures_by_tree", &labelFiguresByTreeArrays);
+  m.def("write_label_mesh_streamed", &writeLabelMeshStreamedFile, py::arg("label"), py::arg("paths"),
+        py::arg("spacing"), py::arg("origin"), py::arg("direction"), py::arg("path"), py::arg("budget"));
   m.def("scan_threshold_block", &scanThresholdBlockArray);
   m.def("merge_threshold_fragments", &mergeThresholdFragmentsArrays);
 }

@@ -15,8 +15,9 @@ a stopped run resumes), one plan task, one task per shard of labels (reads its l
 from the files, merges, writes or returns). Fragments go through the file system, never through
 the scheduler: ``work_dir`` must be shared by every worker. A block's file is the engine's flat
 fragment file (core/include/surftrack/LabelBlockFiles.h), written and read in C++. A label whose
-fragments exceed ``merge_budget`` gets its exact figures from a tree of groups of blocks instead
-of a merged mesh (docs/theory.md, "A label larger than one merge").
+fragments exceed ``merge_budget`` gets its exact figures from a tree of groups of blocks and its
+mesh file streamed from the fragment files, never whole in memory (docs/theory.md, "A label
+larger than one merge").
 
 In Neuroglancer's formats (docs/python.md, "Neuroglancer output on Dask"), the reduce tasks
 encode each label with the single pass' C++ encoders (write_precomputed's), then, sharded, one
@@ -166,13 +167,27 @@ def _reduce_shard(shard, geometry, background, adjacency, figures, out_dir, nami
     """Task: every label of a shard merged; written into `out_dir` (named by _file_name) when it
     is given (the files only, returned as figures), else the surfaces' fields returned. With
     `encoding` (_Encoding), each label encoded in Neuroglancer's format instead (_EncodedLabels).
-    A label whose fragments exceed `budget` bytes gets its figures only (_tree_figures, "file"
-    None; write_label_meshes refuses a budget for Neuroglancer's formats)."""
+    A label whose fragments exceed `budget` bytes gets its figures from the tree (_tree_figures)
+    and, into `out_dir`, its mesh streamed with bounded memory (binary PLY only: with text PLY,
+    "file" None and "no_file" saying why; write_label_meshes refuses a budget for Neuroglancer's
+    formats)."""
     out = {}
     encoded = _EncodedLabels(encoding) if encoding else None
     for label, paths, weight in shard:
         if budget is not None and weight > budget:
-            out[label] = _tree_figures(label, paths, geometry, adjacency, grid, budget)
+            out[label] = tree = _tree_figures(label, paths, geometry, adjacency, grid, budget)
+            if out_dir is not None and encoding is None:
+                if naming is not None and not naming["binary"]:  # (the streamed writer writes binary PLY)
+                    tree["no_file"] = ("over --merge-budget and --ascii: a label's mesh is streamed as binary "
+                                           "PLY only, no text")
+                else:
+                    file = _file_name(label, naming)
+                    counts = _surftrack.write_label_mesh_streamed(label, list(paths), *geometry,
+                                                                  str(Path(out_dir) / file), int(budget))
+                    if tuple(counts) != (tree["vertices"], tree["triangles"]):
+                        raise RuntimeError(f"label {label}: the streamed mesh's counts {tuple(counts)} are not the "
+                                           "tree's")
+                    tree["file"] = file
             continue
         if out_dir is None and encoding is None:  # plain arrays through the scheduler (the C++ result does not pickle)
             fields = _merge_label(label, paths, geometry, background, adjacency, figures)
@@ -445,8 +460,8 @@ def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 
     and "shards" for a sharded layout. ``merge_budget`` (bytes, None: no limit; PLY only): a label
     whose fragments take more is not merged whole: its figures are computed over a tree of groups
     of blocks of at most that many bytes each (docs/theory.md, "A label larger than one merge";
-    counts exact, area and volume up to rounding), its mesh is not written ("file" None,
-    "levels" the tree's)."""
+    counts exact, area and volume up to rounding; "levels" the tree's), and its file, still
+    byte-identical, is written by streaming the fragments (docs/theory.md, "Its mesh, streamed")."""
     if merge_budget is not None and (isinstance(merge_budget, bool) or int(merge_budget) < 0):
         raise ValueError(f"merge_budget must be a number of bytes (>= 0) or None, not {merge_budget!r}")
     if merge_budget is not None and format != "ply":

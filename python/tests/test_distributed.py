@@ -170,10 +170,11 @@ def test_a_work_dir_reused_with_other_arguments_recomputes(client, tmp_path):
     assert len(list(work.iterdir())) == 2 * len(blocks.block_grid(labels.shape, (5, 5, 5)))
 
 
-def test_labels_over_the_merge_budget_get_exact_figures_from_the_tree(client, tmp_path):
-    """write_label_meshes with a merge_budget some labels exceed: those get no file and the single
-    pass's figures (counts exactly, area and volume within 1e-9 relative: summed by groups of
-    blocks, docs/theory.md "A label larger than one merge"); the others their byte-identical file."""
+def test_labels_over_the_merge_budget_get_exact_figures_and_streamed_files(client, tmp_path):
+    """write_label_meshes with a merge_budget some labels exceed: those get the single pass's
+    figures (counts exactly, area and volume within 1e-9 relative: summed by groups of blocks,
+    docs/theory.md "A label larger than one merge") and their file streamed; every file is the
+    single pass's, byte for byte."""
     rng = np.random.default_rng(41)
     shape = (23, 19, 21)
     seeds = rng.integers(0, shape, size=(6, 3))
@@ -193,7 +194,7 @@ def test_labels_over_the_merge_budget_get_exact_figures_from_the_tree(client, tm
     figures = blocks.write_label_meshes(labels, tmp_path / "out", block=(4, 5, 3), spacing=(2.0, 1.0, 0.5),
                                         client=client, work_dir=work, merge_budget=budget)
     assert sorted(figures) == sorted(want)
-    by_tree = [L for L, f in figures.items() if f["file"] is None]
+    by_tree = [L for L, f in figures.items() if "levels" in f]
     assert sorted(by_tree) == sorted(L for L in weight if weight[L] > budget) and 0 < len(by_tree) < len(want)
     assert all(figures[L]["levels"] >= 1 for L in by_tree)
     for label, w in want.items():
@@ -202,11 +203,11 @@ def test_labels_over_the_merge_budget_get_exact_figures_from_the_tree(client, tm
             (w.voxels, len(w.vertices), len(w.faces), w.euler, len(w.components))
         assert f["area"] == pytest.approx(sum(c["area"] for c in w.components), rel=1e-9)
         assert f["volume"] == pytest.approx(sum(c["volume"] for c in w.components), rel=1e-9)
-        if f["file"] is None:
-            assert not (tmp_path / "out" / f"label_{label}.ply").exists()
-        else:
-            w.write(str(tmp_path / "want.ply"))
-            assert (tmp_path / "out" / f["file"]).read_bytes() == (tmp_path / "want.ply").read_bytes()
+        # Merged whole, or streamed (over the budget): the same bytes.
+        w.write(str(tmp_path / "want.ply"))
+        assert f["file"] == f"label_{label}.ply"
+        assert (tmp_path / "out" / f["file"]).read_bytes() == (tmp_path / "want.ply").read_bytes()
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(f"label_{L}.ply" for L in want)
     with pytest.raises(ValueError, match="merge_budget"):
         blocks.write_label_meshes(labels, tmp_path / "bad", client=client, merge_budget=-1)
 
@@ -373,10 +374,11 @@ def test_cli_mesh_all_on_dask_writes_the_single_pass_file(tmp_path):
 
 def test_cli_labels_on_dask_with_a_merge_budget(tmp_path):
     """`surftrack labels STORE -o DIR/ --dask local:2 --merge-budget B` against the CLI's single
-    pass on the same store: the labels within the budget byte for byte; those over it (the
-    fragment files' bytes, counted here from their indices, decide which) with the single pass's
-    counts exactly, area and volume within 1e-9, merge_levels in the table, and the table's row
-    saying whether a mesh file was written (never a file missing without a word)."""
+    pass on the same store: every file byte for byte (those of the labels over the budget
+    streamed; the fragment files' bytes, counted here from their indices, decide which), the
+    single pass's counts exactly, area and volume within 1e-9, merge_levels in the table; with
+    --ascii (not streamed) the rows of the labels over the budget say that no file was written
+    (never a file missing without a word)."""
     import csv
     import json
     rng = np.random.default_rng(43)
@@ -414,17 +416,30 @@ def test_cli_labels_on_dask_with_a_merge_budget(tmp_path):
             assert g[column] == w[column], (label, column)
         assert g["area"] == pytest.approx(w["area"], rel=1e-9) and g["volume"] == pytest.approx(w["volume"], rel=1e-9)
         name = Path(w["file"]).name
-        if label in over:
-            assert g["merge_levels"] >= 1 and g["file"] is None and "merge-budget" in g["no_file"]
-            assert not (dask / name).exists()
-        else:
-            assert "merge_levels" not in g and "no_file" not in g
-            assert (dask / name).read_bytes() == (single / name).read_bytes(), label
+        assert g["file"] == str(dask / name) and "no_file" not in g
+        assert (g.get("merge_levels", 0) >= 1) == (label in over)
+        assert (dask / name).read_bytes() == (single / name).read_bytes(), label  # merged whole or streamed
     rows = list(csv.DictReader(open(dask / "labels.csv")))
-    assert [int(r["label"]) for r in rows] == sorted(weight)
-    assert all((r["no_file"] != "") == (int(r["label"]) in over) for r in rows)
+    assert [int(r["label"]) for r in rows] == sorted(weight) and "no_file" not in rows[0]
     assert all((r["merge_levels"] != "") == (int(r["label"]) in over) for r in rows)
-    assert f"{len(over)} label" in b.stderr and "no mesh file" in b.stderr
+    assert "no mesh file" not in b.stderr
+
+    # Text PLY is not streamed: the labels over the budget get no file, and their rows say so.
+    text = tmp_path / "text"
+    c = run_cli("labels", tmp_path / "s.zarr", "-o", f"{text}/", "--table", tmp_path / "c.json", "--dask", "local:2",
+                "--block", "9,8,12", "--work-dir", work, "--merge-budget", f"{kib}K", "--ascii")
+    assert c.returncode == 0, c.stderr
+    got = {r["label"]: r for r in json.loads((tmp_path / "c.json").read_text())}
+    for label, w in want.items():
+        g, name = got[label], Path(w["file"]).name
+        assert g["surfels"] == w["surfels"] and g["euler"] == w["euler"]
+        if label in over:
+            assert g["file"] is None and "--ascii" in g["no_file"] and not (text / name).exists()
+        else:
+            assert "no_file" not in g and (text / name).exists()
+    rows = list(csv.DictReader(open(text / "labels.csv")))
+    assert all((r["no_file"] != "") == (int(r["label"]) in over) for r in rows)
+    assert f"{len(over)} label" in c.stderr and "no mesh file" in c.stderr
 
 
 def test_cli_merge_budget_bad_input(tmp_path):

@@ -181,3 +181,62 @@ def test_tree_refuses_files_of_another_grid(tmp_path):
                                          IDENTITY, "26-6", 0)
     with pytest.raises(ValueError, match="no fragment file holds label 12345"):
         _surftrack.label_figures_by_tree(12345, paths, [9, 9, 9], [4, 4, 4], [1.0] * 3, [0.0] * 3, IDENTITY, "26-6", 0)
+
+
+def streamed(label, paths, out, budget, spacing=(0.5, 1.0, 4.0), direction=IDENTITY):
+    return _surftrack.write_label_mesh_streamed(label, paths, list(spacing), [1, -2, 3], direction, str(out), budget)
+
+
+def test_streamed_mesh_is_the_single_pass_file(tmp_path):
+    """write_label_mesh_streamed (LabelBlockFiles.h, writeLabelMeshStreamed) against
+    label_surfaces on the whole volume written by Surface.write: the same bytes for every label,
+    every pair, mirrored and not, blocks the shape does not divide (1 voxel thick included), a
+    budget of 0 (chunks of 16 items: every stream crosses chunk boundaries) and a large one; no
+    temporary file left beside the output."""
+    rng = np.random.default_rng(61)
+    for trial, adjacency in enumerate(["26-6", "18-6", "6-18", "6-26"] * 2):
+        labels = random_labels(rng, tuple(int(n) for n in rng.integers(8, 20, size=3)))
+        block = [(1, 5, 3), (4, 4, 4), (7, 2, 6), (30, 30, 30)][trial % 4]
+        folder = tmp_path / str(trial)
+        folder.mkdir()
+        paths = write_blocks(labels, block, folder, adjacency)
+        direction = MIRROR if trial % 2 else IDENTITY
+        want = surftrack.label_surfaces(labels, spacing=(0.5, 1.0, 4.0), origin=(1, -2, 3), direction=direction,
+                                        adjacency=adjacency)
+        out = tmp_path / "out"
+        out.mkdir(exist_ok=True)
+        for label, w in want.items():
+            w.write(str(tmp_path / "want.ply"))
+            for budget in (0, 1 << 30):
+                counts = streamed(label, paths, out / "got.ply", budget, direction=direction)
+                assert counts == (len(w.vertices), len(w.faces))
+                assert (out / "got.ply").read_bytes() == (tmp_path / "want.ply").read_bytes(), (trial, label, budget)
+        assert [p.name for p in out.iterdir()] == ["got.ply"]
+
+
+def test_streamed_mesh_refuses_damaged_files_by_name(tmp_path):
+    """A bit flipped in a label's data (150 random bytes and the last 12) of one of its files: a
+    ValueError naming that file (the checksum, the keys' or indices' checks, or the order of
+    cubes), no output and no temporary file left."""
+    labels = random_labels(np.random.default_rng(67), (10, 9, 11), ids=(3,))
+    paths = write_blocks(labels, (5, 9, 6), tmp_path)
+    (label,) = {L for p in paths for L, _, _ in _surftrack.fragment_file_summary(p)}
+    out = tmp_path / "out"
+    out.mkdir()
+    streamed(label, paths, out / "m.ply", 0)
+    good = open(paths[0], "rb").read()
+    head = 80 + 56
+    picks = np.random.default_rng(71).choice(np.arange(head, len(good) - 12), size=150, replace=False)
+    for at in [*picks.tolist(), *range(len(good) - 12, len(good))]:
+        data = bytearray(good)
+        data[at] ^= 1 << (at % 8)
+        with open(paths[0], "wb") as f:
+            f.write(bytes(data))
+        with pytest.raises(ValueError, match="fragment file") as e:
+            streamed(label, paths, out / "n.ply", 0)
+        assert paths[0] in str(e.value)
+    assert [p.name for p in out.iterdir()] == ["m.ply"]
+    with pytest.raises(ValueError, match="binary .ply"):
+        streamed(label, paths, out / "m.obj", 0)
+    with pytest.raises(ValueError, match="no fragment file holds label 4"):
+        streamed(4, paths, out / "x.ply", 0)

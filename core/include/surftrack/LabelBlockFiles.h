@@ -8,6 +8,7 @@
 //   LabelFigures f = labelFiguresByTree(label, paths, volume, block, geometry, o, budget);
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -83,5 +84,28 @@ struct LabelFigures {
 ///        of one block, or no file holding the label.
 LabelFigures labelFiguresByTree(LabelValue label, const std::vector<std::string>& paths, Dims volume, Dims block,
                                 const ImageGeometry& geometry, const LabelOptions& options, std::uint64_t budget);
+
+/// What writeLabelMeshStreamed wrote.
+struct LabelMeshCounts {
+  std::uint64_t vertices = 0, triangles = 0;
+};
+
+/// Writes the mesh of `label` from its fragment files to `path` (binary .ply) with bounded
+/// memory (docs/theory.md, "A label larger than one merge", "Its mesh, streamed"): the bytes
+/// writeSurface(mergeLabelFragmentFiles(label, paths, geometry, o).surface, path) writes,
+/// without that surface in memory. The vertices come from a k-way merge of the fragments' keys,
+/// the triangles from a k-way merge of the fragments' triangles by owning cube, renumbered
+/// through a file of vertex numbers beside `path`; each fragment is read a chunk at a time from
+/// when the merge reaches its block, the chunk sized so that the chunks of a plane of blocks
+/// take about `budget` bytes (16 to 65,536 items). Atomic (writeFileAtomically); the
+/// temporary files beside `path` are removed. The closed-manifold check writeSurface makes is
+/// not made (it needs the whole mesh): the fragments are checked as readLabelFragment checks
+/// them, and their triangles must come in the block scan's order of cubes.
+/// \throw InvalidInput as readFragmentFileIndex and readLabelFragment, for two files of one
+///        block, no file holding the label, or a path that is not .ply; std::runtime_error
+///        (FileWriteError) when a file cannot be written; Cancelled.
+LabelMeshCounts writeLabelMeshStreamed(LabelValue label, const std::vector<std::string>& paths,
+                                       const ImageGeometry& geometry, const std::string& path, std::uint64_t budget,
+                                       const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace surftrack
