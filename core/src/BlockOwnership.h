@@ -82,6 +82,13 @@ inline void dropUnusedKeys(std::vector<std::uint64_t>& keys, std::vector<std::ar
     for (std::uint32_t& v : t) v = index[v];
 }
 
+/// A cube's min corner packed so that the order of the packed values is the scan's order of
+/// the cubes (z, y, x).
+inline std::uint64_t packedCube(Voxel m) {
+  auto field = [](int v) { return std::uint64_t(v + Surfel::kCoordinateLimit) & 0x1FFFFFu; };
+  return field(m.z) << 42 | field(m.y) << 21 | field(m.x);
+}
+
 /// The min corner of the cube that owns a triangle of these surfels: the componentwise minimum
 /// of their six voxels (no table triangle lies in a cube face, tests/test_configuration_tables.cpp),
 /// packed so that the order of the packed values is the scan's order of the cubes (z, y, x).
@@ -91,8 +98,7 @@ inline std::uint64_t owningCube(const std::array<std::uint64_t, 3>& keys) {
     const Surfel s = Surfel::fromKey(key);
     for (const Voxel v : {s.inside(), s.outside()}) m = {std::min(m.x, v.x), std::min(m.y, v.y), std::min(m.z, v.z)};
   }
-  auto field = [](int v) { return std::uint64_t(v + Surfel::kCoordinateLimit) & 0x1FFFFFu; };
-  return field(m.z) << 42 | field(m.y) << 21 | field(m.x);
+  return packedCube(m);
 }
 
 /// Whether a fragment's keys are surfel keys, strictly increasing.

@@ -106,9 +106,7 @@ struct Fragment {
 
 /// The lowest packed owning cube (BlockOwnership.h, owningCube) of a block's cubes.
 std::uint64_t firstCube(Voxel lo) {
-  auto field = [](int v) { return std::uint64_t(v + Surfel::kCoordinateLimit) & 0x1FFFFFu; };
-  const Voxel m{lo.x == 0 ? -1 : lo.x, lo.y == 0 ? -1 : lo.y, lo.z == 0 ? -1 : lo.z};
-  return field(m.z) << 42 | field(m.y) << 21 | field(m.x);
+  return packedCube({lo.x == 0 ? -1 : lo.x, lo.y == 0 ? -1 : lo.y, lo.z == 0 ? -1 : lo.z});
 }
 
 /// The lowest key of a surfel of a block's cubes: a surfel's voxels lie in the cube, whose min
