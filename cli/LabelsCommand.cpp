@@ -54,16 +54,6 @@ std::string fileSafe(std::string name) {
   return name;
 }
 
-/// Writes `text` to `path` (a temporary file renamed over it).
-void writeText(const std::string& path, const std::string& text) {
-  writeFileAtomically(path, [&](const std::string& temporary) {
-    std::ofstream out(temporary, std::ios::binary);
-    out << text;
-    out.close();
-    return bool(out);
-  });
-}
-
 std::string tableText(const std::string& path, const std::vector<LabelRow>& rows) {
   return fs::path(path).extension() == ".json" ? jsonText(labelTableJson(rows)) + "\n" : labelTableCsv(rows);
 }
@@ -125,9 +115,9 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
       std::cerr << "surftrack: warning: " << unwritten << " label" << (unwritten == 1 ? "" : "s")
                 << " over --merge-budget have figures but no mesh file (the table's no_file column says why)\n";
     if (!precomputed)  // a Neuroglancer directory holds its format's files only, as the single pass writes it
-      writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(run.rows));
+      writeTextFile(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(run.rows));
     staged.commit();
-    if (!o.table.empty()) writeText(o.table, tableText(o.table, run.rows));
+    if (!o.table.empty()) writeTextFile(o.table, tableText(o.table, run.rows));
     clock.lap(timings, "write");
     return run;
   }
@@ -221,10 +211,10 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
                            " edges of four triangles with --walls shared (it touches itself along them): write every "
                            "label to one .ply (-o FILE.ply) instead");
     for (std::size_t i = 0; i < surfaces.size(); ++i) writeSurface(surfaces[i].surface, staged.temporaryFor(rows[i].file), binary);
-    if (kind == OutputKind::Directory) writeText(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(rows));
+    if (kind == OutputKind::Directory) writeTextFile(staged.temporaryFor((fs::path(o.output) / "labels.csv").string()), labelTableCsv(rows));
     staged.commit();
   }
-  if (!o.table.empty()) writeText(o.table, tableText(o.table, rows));
+  if (!o.table.empty()) writeTextFile(o.table, tableText(o.table, rows));
   clock.lap(timings, "write");
   return run;
 }

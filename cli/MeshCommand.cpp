@@ -1,6 +1,7 @@
 // `surftrack mesh INPUT -o OUTPUT [options]`.
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -54,11 +55,47 @@ std::uintmax_t directoryBytes(const std::string& directory) {
   return total;
 }
 
+/// `-o DIR/` (a path ending in '/' or an existing directory): one file per boundary.
+bool perBoundaryOutput(const MeshOptions& o) {
+  std::error_code ec;
+  return o.format.empty() && !o.output.empty() && (o.output.back() == '/' || std::filesystem::is_directory(o.output, ec));
+}
+
+/// The file of the k-th boundary (from 1, the components' order) in -o DIR/.
+std::string boundaryFile(const std::string& directory, std::size_t k) {
+  return (std::filesystem::path(directory) / ("boundary_" + std::to_string(k) + ".ply")).string();
+}
+
+/// DIR/boundaries.csv: a row per boundary (its figures, physical area and volume, its file).
+std::string boundaryTableCsv(const std::vector<ComponentFigures>& boundaries, const std::string& directory) {
+  std::ostringstream out;
+  out << "boundary,vertices,triangles,edges,euler,genus,area,volume,file\n";
+  for (std::size_t k = 0; k < boundaries.size(); ++k) {
+    const ComponentFigures& c = boundaries[k];
+    out << k + 1 << ',' << c.surfels << ',' << c.triangles << ',' << c.edges << ',' << c.euler << ','
+        << num(c.genus()) << ',' << num(c.area, 10) << ',' << num(c.volume, 10) << ','
+        << boundaryFile(directory, k + 1) << '\n';
+  }
+  return out.str();
+}
+
+/// The boundaries' files and table written into `staged` (-o DIR/, the single pass).
+void writeBoundaryFiles(const Surface& surface, const std::string& directory, bool binary, StagedOutputs& staged) {
+  std::vector<std::string> temporaries;
+  for (std::size_t k = 1; k <= surface.components.size(); ++k)
+    temporaries.push_back(staged.temporaryFor(boundaryFile(directory, k)));
+  writeSurfaceComponents(surface, temporaries, binary);
+  writeTextFile(staged.temporaryFor((std::filesystem::path(directory) / "boundaries.csv").string()),
+                boundaryTableCsv(surface.components, directory));
+}
+
 }  // namespace
 
 /// `mesh STORE --all --iso S --dask ADDRESS`: every boundary by blocks on Dask, the same file as
 /// the single pass (DaskJob.h); the summary gives the driver's figures.
 static int meshAllOnDask(const MeshOptions& o, bool binary) {
+  const bool perBoundary = perBoundaryOutput(o);
+  StagedOutputs staged = perBoundary ? StagedOutputs::inDirectory(o.output) : StagedOutputs();
   ImageGeometry g;
   nlohmann::json job = storeJob(o.input, o.dask, o.block, o.workDir, g);
   job["kind"] = "threshold";
@@ -66,11 +103,32 @@ static int meshAllOnDask(const MeshOptions& o, bool binary) {
   job["mapping"] = o.surface.mapping == MappingMode::Midpoint ? "midpoint" : "linear";
   job["adjacency"] = toString(o.surface.pair);
   const std::string output = std::filesystem::absolute(o.output).string();
-  job["output"] = output;
+  job["output"] = perBoundary ? nlohmann::json(nullptr) : nlohmann::json(output);
+  // -o DIR/: the merge task writes each boundary's file into the staging directory, named as
+  // the single pass names them (boundaryFile); the table is written here.
+  job["output_dir"] = perBoundary ? nlohmann::json(staged.stagingDirectory()) : nlohmann::json(nullptr);
   job["binary"] = binary;
   job["quiet"] = o.out.quiet;
   const StageClock clock;
-  const nlohmann::json r = runDaskJob(job, output, "");
+  const std::string scratch = perBoundary ? staged.stagingDirectory() : output;
+  const nlohmann::json r = runDaskJob(job, scratch, perBoundary ? scratch : "");
+  if (perBoundary) {
+    std::vector<ComponentFigures> boundaries;
+    for (const nlohmann::json& c : r.at("components")) {
+      ComponentFigures f;
+      f.surfels = c.at("surfels").get<std::size_t>();
+      f.triangles = c.at("triangles").get<std::size_t>();
+      f.edges = c.at("edges").get<std::size_t>();
+      f.euler = c.at("euler").get<long long>();
+      f.area = c.at("area").get<double>();
+      f.volume = c.at("volume").get<double>();
+      boundaries.push_back(f);
+      staged.temporaryFor(boundaryFile(o.output, boundaries.size()));  // (written there by the merge task)
+    }
+    writeTextFile(staged.temporaryFor((std::filesystem::path(o.output) / "boundaries.csv").string()),
+                  boundaryTableCsv(boundaries, o.output));
+    staged.commit();
+  }
   nlohmann::ordered_json j;
   j["input"] = o.input.path;
   j["output"] = o.output;
@@ -96,15 +154,21 @@ int runMesh(const std::vector<std::string>& args) {
   Extraction x;
   x.output = o.output;
   const bool precomputed = !o.format.empty();  // a Neuroglancer directory
-  x.format = precomputed ? o.format : meshFormat(o.output);  // a usage error, before any work
+  const bool perBoundary = perBoundaryOutput(o);
+  if (perBoundary && o.surface.seedMode != SeedMode::All)
+    throw UsageError("-o DIR/ writes one file per boundary: give --all, or -o FILE for one mesh");
+  x.format = precomputed ? o.format : perBoundary ? "ply" : meshFormat(o.output);  // a usage error, before any work
   x.binary = !o.ascii && (x.format == "ply" || x.format == "stl");
+  if (!o.dask.empty()) return meshAllOnDask(o, x.binary);
+  StagedOutputs staged = perBoundary ? StagedOutputs::inDirectory(o.output) : StagedOutputs();
   if (precomputed) {
     requireOutputDirectory(o.output);
+  } else if (perBoundary) {
+    requireNotInput(o.output, o.input.path);
   } else {
     requireWritable(o.output);  // fail now rather than after the work
     requireNotInput(o.output, o.input.path);
   }
-  if (!o.dask.empty()) return meshAllOnDask(o, x.binary);
   SpacingUnit unit{o.unit, "", ""};
 
   Progress progress(Progress::wanted(o.out.quiet));
@@ -130,6 +194,10 @@ int runMesh(const std::vector<std::string>& args) {
   progress.stage(stages - 1, stages, "writing " + o.output);
   if (precomputed) {
     writePrecomputedOutput({{o.id, &x.surface, ""}}, o.output, o.format, x.surface.geometry, unit, o.precomputed);
+    x.bytes = directoryBytes(o.output);
+  } else if (perBoundary) {
+    writeBoundaryFiles(x.surface, o.output, x.binary, staged);
+    staged.commit();
     x.bytes = directoryBytes(o.output);
   } else {
     x.bytes = writeMeshFile(x.surface, o.output, x.binary);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 #include "MeshIO.h"
@@ -61,6 +62,15 @@ std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bo
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(path, ec);
   return ec ? 0 : size;
+}
+
+void writeTextFile(const std::string& path, const std::string& text) {
+  writeFileAtomically(path, [&](const std::string& temporary) {
+    std::ofstream out(temporary, std::ios::binary);
+    out << text;
+    out.close();
+    return bool(out);
+  });
 }
 
 namespace {

@@ -37,6 +37,9 @@ void requireNotInput(const std::string& output, const std::string& input);
 /// writers (converter/MeshIO.h writeTriangles); returns the file size.
 std::uintmax_t writeMeshFile(const Surface& surface, const std::string& path, bool binary);
 
+/// Writes `text` to `path` (a temporary file renamed over it).
+void writeTextFile(const std::string& path, const std::string& text);
+
 /// Several output files written completely or not at all: each is written under a temporary
 /// name (a LiveTemporary, removed by the tool's handler of SIGINT: cli/Interrupt.h), and
 /// commit() moves them all into place, with SIGINT and SIGTERM held until it is done. In a

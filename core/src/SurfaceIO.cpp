@@ -30,6 +30,28 @@ void writeSurface(const Surface& surface, const std::string& path, bool binary, 
   }
 }
 
+void writeSurfaceComponents(const Surface& surface, const std::vector<std::string>& paths, bool binary,
+                            const std::atomic<bool>* cancel) {
+  std::vector<std::uint32_t> componentOf;
+  const std::size_t count = componentFigures(surface.vertices, surface.triangles, &componentOf).size();
+  if (paths.size() != count)
+    throw InvalidInput("the surface has " + std::to_string(count) + " components, not " +
+                       std::to_string(paths.size()) + " (one file each)");
+  std::vector<Surface> parts(count);
+  std::vector<std::uint32_t> index(surface.vertices.size());
+  for (std::size_t v = 0; v < surface.vertices.size(); ++v) {  // in the surface's order
+    Surface& part = parts[componentOf[v]];
+    index[v] = std::uint32_t(part.vertices.size());
+    part.vertices.push_back(surface.vertices[v]);
+  }
+  for (const auto& t : surface.triangles)  // a triangle's corners share its component
+    parts[componentOf[t[0]]].triangles.push_back({index[t[0]], index[t[1]], index[t[2]]});
+  for (std::size_t k = 0; k < count; ++k) {
+    writeSurface(parts[k], paths[k], binary, cancel);
+    parts[k] = Surface();  // (one component held twice at most)
+  }
+}
+
 void writeLabelSurfaces(const std::vector<LabelSurface>& surfaces, const std::string& path, bool binary) {
   std::vector<LabelledMesh> meshes;
   for (const LabelSurface& ls : surfaces)

@@ -747,10 +747,9 @@ py::dict mergeThresholdFragmentsArrays(py::list fragments, std::array<int, 3> vo
   return d;
 }
 
-void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
-                 py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> faces,
-                 py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> surfels,
-                 const std::string& path, bool binary) {
+Surface surfaceOfArrays(py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
+                        py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> faces,
+                        py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> surfels) {
   if (vertices.ndim() != 2 || vertices.shape(1) != 3) throw py::value_error("vertices must be (N, 3)");
   if (faces.ndim() != 2 || faces.shape(1) != 3) throw py::value_error("faces must be (M, 3)");
   Surface s;
@@ -774,8 +773,27 @@ void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> 
       if (idx < 0 || std::size_t(idx) >= n) throw py::value_error("a face refers to a vertex that does not exist");
       s.triangles[t][k] = std::uint32_t(idx);
     }
+  return s;
+}
+
+void writeArrays(py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
+                 py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> faces,
+                 py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> surfels,
+                 const std::string& path, bool binary) {
+  const Surface s = surfaceOfArrays(vertices, faces, surfels);
   std::atomic<bool> cancel{false};
   runWatchingSignals(cancel, [&] { writeSurface(s, path, binary, &cancel); });
+}
+
+/// writeSurfaceComponents: each connected component to its own file, paths in the order of the
+/// surface's components table.
+void writeComponentArrays(py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
+                          py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> faces,
+                          py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> surfels,
+                          const std::vector<std::string>& paths, bool binary) {
+  const Surface s = surfaceOfArrays(vertices, faces, surfels);
+  std::atomic<bool> cancel{false};
+  runWatchingSignals(cancel, [&] { writeSurfaceComponents(s, paths, binary, &cancel); });
 }
 
 /// A mesh's (N, 3) vertices and (M, 3) faces copied into the writers' arrays.
@@ -978,6 +996,7 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("read_store_box", &readStoreBox);
   m.def("label_surfaces_array", &labelSurfacesArray);
   m.def("write_arrays", &writeArrays);
+  m.def("write_component_arrays", &writeComponentArrays);
   m.def("write_precomputed", &writePrecomputed);
   m.def("encode_precomputed_segment", &encodePrecomputedSegment);
   m.def("precomputed_info", &precomputedInfo);

@@ -113,6 +113,14 @@ class Surface:
         when it cannot be written, KeyboardInterrupt on Ctrl-C (nothing written)."""
         _surftrack.write_arrays(self.vertices, self.faces, self.surfels, str(path), binary)
 
+    def write_components(self, paths, binary: bool = True) -> None:
+        """Writes each connected component (each boundary of ``mode="all"``) to its own file:
+        ``paths[k]`` the k-th of ``components`` (by decreasing vertex count, ties by smallest
+        vertex), its vertices and faces in this surface's order, renumbered from 0 (the CLI's
+        ``mesh --all -o DIR/``). Each file as ``write``; ValueError when ``len(paths)`` is not
+        the number of components."""
+        _surftrack.write_component_arrays(self.vertices, self.faces, self.surfels, [str(p) for p in paths], binary)
+
 
 def _store_path(volume) -> Optional[str]:
     """The directory of a chunked store the engine reads itself: a path to one, or a zarr array

@@ -90,7 +90,7 @@ def run(job: dict) -> list:
             if job["kind"] == "threshold":
                 return distributed._run_threshold(source, job["iso"], mapping=job["mapping"], epsilon=1e-3,
                                                   figures=True, out_path=job["output"], binary=job["binary"],
-                                                  **common)
+                                                  out_dir=job.get("output_dir"), **common)
             precomputed = _precomputed(job)
             return distributed._run(source, background=int(job["background"]), figures=True,
                                     out_dir=None if precomputed else job["staging"], shards=None,

@@ -530,9 +530,12 @@ def _threshold_block(source, lo, hi, shape, level, adjacency, mapping, epsilon, 
     return str(path)
 
 
-def _reduce_threshold(paths, shape, level, geometry, adjacency, mapping, epsilon, figures, out_path, binary):
+def _reduce_threshold(paths, shape, level, geometry, adjacency, mapping, epsilon, figures, out_path, binary,
+                      out_dir=None):
     """Task: every block's fragment merged into the one surface of every boundary (all in this
-    worker's memory); written to `out_path` (figures returned) or returned as fields."""
+    worker's memory); written to `out_path` (figures returned), or one file per boundary into
+    `out_dir` (boundary_<k>.ply, Surface.write_components; figures with a row per boundary
+    returned), or returned as fields."""
     from . import Surface
     fragments = []
     for path in paths:
@@ -541,18 +544,24 @@ def _reduce_threshold(paths, shape, level, geometry, adjacency, mapping, epsilon
     spacing, origin, direction = geometry
     fields = _surftrack.merge_threshold_fragments(fragments, list(shape), float(level), spacing, origin, direction,
                                                   adjacency, mapping, float(epsilon), figures)
-    if out_path is None:  # plain arrays through the scheduler (the C++ result does not pickle)
+    if out_path is None and out_dir is None:  # plain arrays through the scheduler (the C++ result does not pickle)
         result = fields.pop("result")
         fields["surfels"], fields["normals"] = result.surfels(), result.normals()
         return fields
     surface = Surface(**fields)
+    out = {"vertices": len(surface.vertices), "triangles": len(surface.faces), "euler": int(fields["euler"]),
+           "boundaries": len(surface.components)}
+    if out_dir is not None:
+        names = [f"boundary_{k}.ply" for k in range(1, len(surface.components) + 1)]
+        surface.write_components([str(Path(out_dir) / n) for n in names], binary=binary)
+        out["components"] = [{**c, "file": n} for c, n in zip(surface.components, names)]
+        return out
     surface.write(out_path, binary=binary)
-    return {"vertices": len(surface.vertices), "triangles": len(surface.faces), "euler": int(fields["euler"]),
-            "boundaries": len(surface.components)}
+    return out
 
 
 def _run_threshold(source, level, *, block, mapping, adjacency, spacing, origin, direction, epsilon, figures,
-                   client, workers, work_dir, out_path, binary, progress):
+                   client, workers, work_dir, out_path, binary, progress, out_dir=None):
     from . import _MAPPINGS, _geometry
 
     shape = _check_volume(source, adjacency, integers=False)
@@ -572,7 +581,7 @@ def _run_threshold(source, level, *, block, mapping, adjacency, spacing, origin,
         futures = _map_blocks(client, _threshold_block, source, blocks,
                               (shape, level, adjacency, mapping, epsilon, work_dir, run), progress)
         merged = client.submit(_reduce_threshold, futures, shape, level, geometry, adjacency, mapping, epsilon,
-                               figures, out_path, binary, pure=False)
+                               figures, out_path, binary, out_dir, pure=False)
         out = merged.result()
         if progress:
             progress("merge", 1, 1)
@@ -609,6 +618,33 @@ def write_threshold_mesh(volume, path, level, *, block=(256, 256, 256), mapping=
                               origin=origin, direction=direction, epsilon=epsilon, figures=True, client=client,
                               workers=workers, work_dir=work, out_path=os.path.abspath(os.fspath(path)),
                               binary=binary, progress=progress)
+
+
+def write_threshold_meshes(volume, out_dir, level, *, block=(256, 256, 256), mapping="linear", adjacency="26-6",
+                           spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, epsilon=1e-3,
+                           binary=True, client=None, workers=None, work_dir=None, progress=None) -> dict:
+    """Every boundary of ``volume > level``, each in its own file ``out_dir/boundary_<k>.ply``
+    (k from 1, in the order of the surface's ``components``: by decreasing vertex count), each
+    byte-identical to ``surftrack.extract(volume, level=level, mode="all",
+    ...).write_components(...)``, written by the merge task. ``out_dir`` (shared by the workers)
+    must not exist or be empty; it appears whole at the end or not at all. Returns the figures of
+    write_threshold_mesh and ``"components"``: a row per boundary (its figures and file)."""
+    target = Path(out_dir)
+    if target.exists() and (not target.is_dir() or any(target.iterdir())):
+        raise ValueError(f"cannot write into '{out_dir}': it exists and is not an empty directory")
+    staging = target.parent / f".{target.name}.tmp-{uuid.uuid4().hex}"
+    staging.mkdir(parents=True)
+    try:
+        with _work_dir(work_dir) as work:
+            out = _run_threshold(volume, level, block=block, mapping=mapping, adjacency=adjacency, spacing=spacing,
+                                 origin=origin, direction=direction, epsilon=epsilon, figures=True, client=client,
+                                 workers=workers, work_dir=work, out_path=None, binary=binary, progress=progress,
+                                 out_dir=str(staging.resolve()))
+        os.replace(staging, target)  # replaces an empty directory
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    return out
 
 
 class _work_dir:

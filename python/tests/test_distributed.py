@@ -453,3 +453,106 @@ def test_cli_merge_budget_bad_input(tmp_path):
         r = run_cli("labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/out/", *args)
         assert r.returncode != 0 and says in r.stderr and r.stderr.count("\n") == 1, (args, r.stderr)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr"]
+
+
+def read_binary_ply(path):
+    """(vertices (N, 3) float32, faces (M, 3) int) of a binary PLY of this tool's layout, by numpy."""
+    data = Path(path).read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().split("\n")
+    n = int(next(line for line in header if line.startswith("element vertex")).split()[-1])
+    m = int(next(line for line in header if line.startswith("element face")).split()[-1])
+    vertices = np.frombuffer(data, dtype="<f4", count=3 * n, offset=end).reshape(n, 3)
+    faces = np.frombuffer(data, dtype=np.dtype([("k", "u1"), ("v", "<i4", 3)]), count=m, offset=end + 12 * n)
+    assert (faces["k"] == 3).all() and end + 12 * n + 13 * m == len(data)
+    return vertices, faces["v"].astype(np.int64)
+
+
+def split_by_numpy(vertices, faces):
+    """The connected components of a mesh, by scipy's graph components: each (vertices, faces) in
+    the mesh's order renumbered, by decreasing vertex count, ties by smallest vertex."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    n = len(vertices)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]]])
+    _, label = connected_components(coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)),
+                                    directed=False)
+    first = {c: int(np.flatnonzero(label == c)[0]) for c in np.unique(label)}
+    order = sorted(first, key=lambda c: (-int((label == c).sum()), first[c]))
+    parts = []
+    for c in order:
+        keep = np.flatnonzero(label == c)
+        index = np.full(n, -1)
+        index[keep] = np.arange(len(keep))
+        mine = faces[label[faces[:, 0]] == c]
+        parts.append((vertices[keep], index[mine]))
+    return parts
+
+
+def test_threshold_meshes_one_file_per_boundary(client, tmp_path):
+    """write_threshold_meshes: a file per boundary, each byte-identical to the single pass's
+    Surface.write_components, and equal to the single pass's whole mesh split by scipy's graph
+    components (vertices to the float, faces exactly); the figures per boundary are the single
+    pass's."""
+    rng = np.random.default_rng(47)
+    shape = (19, 23, 17)
+    volume = rng.random(shape).astype(np.float32)
+    want = surftrack.extract(volume, level=0.8, mode="all", spacing=(1.5, 1.0, 2.0), threads=1)
+    assert len(want.components) > 10
+    figures = blocks.write_threshold_meshes(volume, tmp_path / "out", 0.8, block=(7, 9, 5), spacing=(1.5, 1.0, 2.0),
+                                            client=client)
+    names = [f"boundary_{k}.ply" for k in range(1, len(want.components) + 1)]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(names)
+    (tmp_path / "want").mkdir()
+    want.write_components([tmp_path / "want" / n for n in names])
+    parts = split_by_numpy(want.vertices.astype(np.float32), want.faces.astype(np.int64))
+    for n, row, w, (v, f) in zip(names, figures["components"], want.components, parts):
+        assert (tmp_path / "out" / n).read_bytes() == (tmp_path / "want" / n).read_bytes(), n
+        got_v, got_f = read_binary_ply(tmp_path / "out" / n)
+        assert np.array_equal(got_v, v) and np.array_equal(got_f, f), n
+        assert row["file"] == n and {k: row[k] for k in w} == w
+    with pytest.raises(ValueError, match="not an empty directory"):
+        blocks.write_threshold_meshes(volume, tmp_path / "out", 0.8, client=client)
+
+
+def test_cli_mesh_all_on_dask_one_file_per_boundary(tmp_path):
+    """`surftrack mesh STORE --all --iso S -o DIR/ --dask local:2` against the CLI's single pass
+    `-o DIR/`: the same files byte for byte (boundary_<k>.ply and boundaries.csv, but for the
+    directory in its file column), both equal to the single pass's one-file mesh split by
+    scipy's graph components; text PLY too; -o DIR/ without --all refused."""
+    rng = np.random.default_rng(53)
+    shape = (21, 18, 25)
+    volume = (rng.random(shape) * 100).astype("<f4")
+    zarr.open(str(tmp_path / "v.zarr"), mode="w", shape=shape, chunks=(8, 7, 9), dtype="<f4")[:] = volume
+    for extra in [["--spacing", "1,2,3"], ["--mapping", "midpoint", "--adjacency", "6-18", "--ascii"]]:
+        tag = len(extra)
+        single, dask, whole = tmp_path / f"single{tag}", tmp_path / f"dask{tag}", tmp_path / f"whole{tag}.ply"
+        args = ["mesh", tmp_path / "v.zarr", "--all", "--iso", 85, *extra]
+        a = run_cli(*args, "-o", f"{single}/")
+        assert a.returncode == 0, a.stderr
+        b = run_cli(*args, "-o", f"{dask}/", "--dask", "local:2", "--block", "8,10,6")
+        assert b.returncode == 0, b.stderr
+        files = sorted(p.name for p in single.iterdir())
+        assert files == sorted(p.name for p in dask.iterdir()) and len(files) > 10
+        for f in files:
+            left, right = (single / f).read_bytes(), (dask / f).read_bytes()
+            if f == "boundaries.csv":
+                left, right = left.replace(str(single).encode(), b"D"), right.replace(str(dask).encode(), b"D")
+            assert left == right, f
+        if "--ascii" in extra:
+            continue
+        c = run_cli(*args, "-o", whole)
+        assert c.returncode == 0, c.stderr
+        parts = split_by_numpy(*read_binary_ply(whole))
+        assert len(files) == len(parts) + 1
+        import csv
+        rows = list(csv.DictReader(open(single / "boundaries.csv")))
+        for k, (v, f) in enumerate(parts, 1):
+            got_v, got_f = read_binary_ply(single / f"boundary_{k}.ply")
+            assert np.array_equal(got_v, v) and np.array_equal(got_f, f), k
+            assert rows[k - 1]["boundary"] == str(k) and int(rows[k - 1]["vertices"]) == len(v)
+            assert int(rows[k - 1]["triangles"]) == len(f)
+            assert Path(rows[k - 1]["file"]).name == f"boundary_{k}.ply"
+    r = run_cli("mesh", tmp_path / "v.zarr", "--iso", 85, "-o", f"{tmp_path}/e/")
+    assert r.returncode != 0 and "--all" in r.stderr and r.stderr.count("\n") == 1, r.stderr
+    assert not (tmp_path / "e").exists()

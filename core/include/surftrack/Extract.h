@@ -189,4 +189,13 @@ std::vector<ComponentFigures> componentFigures(
 void writeSurface(const Surface& surface, const std::string& path, bool binary = true,
                   const std::atomic<bool>* cancel = nullptr);
 
+/// Writes each connected component of the surface (each boundary, with the scanning rules) to
+/// its own file as writeSurface does: paths[k] receives the k-th component of componentFigures'
+/// order (by decreasing vertex count, ties by smallest vertex: Surface::components' order), its
+/// vertices and triangles in the surface's order, renumbered from 0 (docs/cli.md, "One file per
+/// boundary"). \throw InvalidInput when paths.size() is not the number of components; as
+/// writeSurface otherwise (the files written before a failure stay: stage them).
+void writeSurfaceComponents(const Surface& surface, const std::vector<std::string>& paths, bool binary = true,
+                            const std::atomic<bool>* cancel = nullptr);
+
 }  // namespace surftrack
