@@ -532,7 +532,9 @@ MeshArgs defineMesh(CLI::App& app, MeshOptions& o, std::string& mapping) {
   MeshArgs a;
   addInput(app, o.input);
   app.add_option("-o,--output", o.output,
-                 ".ply (binary unless --ascii), .obj, .off, .stl; vertices in physical\ncoordinates")
+                 ".ply (binary unless --ascii), .obj, .off, .stl; vertices in physical\ncoordinates; "
+                 "with --all, DIR/: one PLY per boundary, DIR/boundary_<k>.ply\n(largest first), and "
+                 "DIR/boundaries.csv")
       ->option_text("OUTPUT")
       ->group("input and output");
   app.add_option("--cache", o.cacheMiB, "a chunked store read lazily (a seed rule with --iso or --label):\n"
