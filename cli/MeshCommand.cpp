@@ -55,10 +55,16 @@ std::uintmax_t directoryBytes(const std::string& directory) {
   return total;
 }
 
-/// `-o DIR/` (a path ending in '/' or an existing directory): one file per boundary.
+/// `--all -o DIR/` (a path ending in '/' or an existing directory): one file per boundary.
+/// Without --all, a path ending in '/' is refused; an existing directory is the error of any
+/// unwritable file (OutputFile.h).
 bool perBoundaryOutput(const MeshOptions& o) {
+  if (!o.format.empty() || o.output.empty()) return false;
   std::error_code ec;
-  return o.format.empty() && !o.output.empty() && (o.output.back() == '/' || std::filesystem::is_directory(o.output, ec));
+  const bool all = o.surface.seedMode == SeedMode::All;
+  if (o.output.back() == '/' && !all)
+    throw UsageError("-o DIR/ writes one file per boundary: give --all, or -o FILE for one mesh");
+  return all && (o.output.back() == '/' || std::filesystem::is_directory(o.output, ec));
 }
 
 /// The file of the k-th boundary (from 1, the components' order) in -o DIR/.
@@ -155,8 +161,6 @@ int runMesh(const std::vector<std::string>& args) {
   x.output = o.output;
   const bool precomputed = !o.format.empty();  // a Neuroglancer directory
   const bool perBoundary = perBoundaryOutput(o);
-  if (perBoundary && o.surface.seedMode != SeedMode::All)
-    throw UsageError("-o DIR/ writes one file per boundary: give --all, or -o FILE for one mesh");
   x.format = precomputed ? o.format : perBoundary ? "ply" : meshFormat(o.output);  // a usage error, before any work
   x.binary = !o.ascii && (x.format == "ply" || x.format == "stl");
   if (!o.dask.empty()) return meshAllOnDask(o, x.binary);
