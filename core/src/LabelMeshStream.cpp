@@ -169,6 +169,8 @@ class Streams {
         } else {  // its keys are done
           writeNumbers(f, remap);
           f.keysChecksum = f.keySum.finish();
+          if (f.entry.triangles == 0 && FragmentChecksum(f.keysChecksum).finish() != f.entry.checksum)
+            bad(*f.path, "corrupted (the data of label " + f.entry.label.text() + " do not match their checksum)");
           std::vector<std::uint64_t>().swap(f.keys);
           std::vector<std::uint32_t>().swap(f.numbers);
           continue;

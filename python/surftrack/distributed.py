@@ -465,15 +465,10 @@ def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 
     if merge_budget is not None and (isinstance(merge_budget, bool) or int(merge_budget) < 0):
         raise ValueError(f"merge_budget must be a number of bytes (>= 0) or None, not {merge_budget!r}")
     if merge_budget is not None and format != "ply":
-        raise ValueError("merge_budget is for format='ply': a label over the budget gets no mesh, and Neuroglancer's "
-                         "formats hold every label")
-    target = Path(out_dir)
+        raise ValueError("merge_budget is for format='ply': Neuroglancer's formats encode every label whole")
     precomputed = _precomputed_job(format, axes=axes, unit=unit, spacing=spacing, names=names, lods=lods,
                                    sharded=sharded, quantization_bits=quantization_bits)
-    if target.exists() and (not target.is_dir() or any(target.iterdir())):
-        raise ValueError(f"cannot write into '{out_dir}': it exists and is not an empty directory")
-    staging = target.parent / f".{target.name}.tmp-{uuid.uuid4().hex}"
-    staging.mkdir(parents=True)
+    target, staging = _staging_for(out_dir)
     try:
         with _work_dir(work_dir) as work:
             if precomputed is not None:
@@ -629,11 +624,7 @@ def write_threshold_meshes(volume, out_dir, level, *, block=(256, 256, 256), map
     ...).write_components(...)``, written by the merge task. ``out_dir`` (shared by the workers)
     must not exist or be empty; it appears whole at the end or not at all. Returns the figures of
     write_threshold_mesh and ``"components"``: a row per boundary (its figures and file)."""
-    target = Path(out_dir)
-    if target.exists() and (not target.is_dir() or any(target.iterdir())):
-        raise ValueError(f"cannot write into '{out_dir}': it exists and is not an empty directory")
-    staging = target.parent / f".{target.name}.tmp-{uuid.uuid4().hex}"
-    staging.mkdir(parents=True)
+    target, staging = _staging_for(out_dir)
     try:
         with _work_dir(work_dir) as work:
             out = _run_threshold(volume, level, block=block, mapping=mapping, adjacency=adjacency, spacing=spacing,
@@ -645,6 +636,18 @@ def write_threshold_meshes(volume, out_dir, level, *, block=(256, 256, 256), map
         shutil.rmtree(staging, ignore_errors=True)
         raise
     return out
+
+
+def _staging_for(out_dir):
+    """(out_dir, its staging directory, made): `out_dir` must not exist or be empty; the outputs
+    are written into the staging directory, which is renamed to `out_dir` at the end, so that
+    it appears whole or not at all."""
+    target = Path(out_dir)
+    if target.exists() and (not target.is_dir() or any(target.iterdir())):
+        raise ValueError(f"cannot write into '{out_dir}': it exists and is not an empty directory")
+    staging = target.parent / f".{target.name}.tmp-{uuid.uuid4().hex}"
+    staging.mkdir(parents=True)
+    return target, staging
 
 
 class _work_dir:
