@@ -5,7 +5,8 @@
 // random regular grids of blocks:
 // - a file read back gives the fragments written, label for label, and the same bytes when
 //   written again;
-// - mergeLabelFragmentFiles is the single pass's surface, array for array;
+// - mergeLabelFragmentFiles is the single pass's surface, array for array, and
+//   writeLabelMeshStreamed writes writeSurface's bytes of it (small chunks and whole fragments);
 // - labelFiguresByTree with budget 0 (single-block leaves, the grid's whole depth) and with a
 //   random budget gives every count, Euler characteristic and the components' order exactly,
 //   area and volume within 1e-9 relative (summed by groups: another order of the same terms).
@@ -112,6 +113,16 @@ TEST(LabelBlockFiles, FilesMergesAndTreeFiguresAreTheSinglePass) {
       ASSERT_EQ(got.surface.vertices, want.surface.vertices);
       ASSERT_EQ(got.surface.triangles, want.surface.triangles);
       EXPECT_EQ(got.voxels, want.voxels);
+      // Streamed (chunks of 16 items, and whole fragments): writeSurface's bytes (odd
+      // iterations, the mirrored geometries among them).
+      if (iteration % 2 == 1) writeSurface(want.surface, (dir / "want.ply").string());
+      for (const std::uint64_t budget : {std::uint64_t(0), std::uint64_t(1) << 32}) {
+        if (iteration % 2 == 0) break;
+        const LabelMeshCounts n = writeLabelMeshStreamed(want.label, paths, geometry, (dir / "got.ply").string(), budget);
+        EXPECT_EQ(n.vertices, want.surface.vertices.size());
+        EXPECT_EQ(n.triangles, want.surface.triangles.size());
+        ASSERT_EQ(bytesOf((dir / "got.ply").string()), bytesOf((dir / "want.ply").string())) << want.label.text();
+      }
       std::uint64_t weight = 0;
       for (const std::string& p : paths) {
         const FragmentFileIndex index = readFragmentFileIndex(p);  // find() points into it
