@@ -163,16 +163,16 @@ int runMesh(const std::vector<std::string>& args) {
   const bool perBoundary = perBoundaryOutput(o);
   x.format = precomputed ? o.format : perBoundary ? "ply" : meshFormat(o.output);  // a usage error, before any work
   x.binary = !o.ascii && (x.format == "ply" || x.format == "stl");
-  if (!o.dask.empty()) return meshAllOnDask(o, x.binary);
-  StagedOutputs staged = perBoundary ? StagedOutputs::inDirectory(o.output) : StagedOutputs();
   if (precomputed) {
     requireOutputDirectory(o.output);
   } else if (perBoundary) {
-    requireNotInput(o.output, o.input.path);
+    requireNotInput(o.output, o.input.path);  // (the directory is checked as it is staged)
   } else {
     requireWritable(o.output);  // fail now rather than after the work
     requireNotInput(o.output, o.input.path);
   }
+  if (!o.dask.empty()) return meshAllOnDask(o, x.binary);
+  StagedOutputs staged = perBoundary ? StagedOutputs::inDirectory(o.output) : StagedOutputs();
   SpacingUnit unit{o.unit, "", ""};
 
   Progress progress(Progress::wanted(o.out.quiet));
