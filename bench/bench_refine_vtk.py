@@ -114,6 +114,11 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     bench = os.path.join(a.build, "bench", "bench_refine")
     tool = os.path.join(a.build, "tests", "surftrack_mesh_check")
+    needed = [bench] + ([] if a.skip_checks else [tool]) + ([os.path.join(a.build, "bench", "bench_decimation_floor")] if a.floor else [])
+    for binary in needed:
+        if not os.path.exists(binary):
+            sys.exit(f"bench_refine_vtk: no {binary}: configure the build with -DSURFTRACK_BUILD_BENCH=ON "
+                     f"and build the benchmarks")
     command = [bench, "--size", str(a.size), "--iterations", str(a.iterations), "--max-error", str(a.max_error),
                "--reduce", str(a.reduce), "--threads", str(a.threads), "--out", a.out]
     if a.input:

@@ -15,7 +15,9 @@
 #include <regex>
 #include <sstream>
 #include <tuple>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 #include <gdcmTrace.h>
 #include <gdcmUIDGenerator.h>
@@ -192,28 +194,91 @@ LoadedVolume toLoaded(const itk::SmartPointer<itk::Image<T, 3>>& image, const st
   return out;
 }
 
+/// The image type whose reader gives readFileAs and readSeriesAs the output information (size,
+/// spacing, origin, direction) ITK's readers give every pixel type: it does not depend on the
+/// pixel type (ImageFileReader::GenerateOutputInformation, ImageSeriesReader's likewise).
+using InformationImage = itk::Image<std::uint8_t, 3>;
+
+/// A fresh image of T with the geometry of `information`.
 template <class T>
-ImagePointer<T> readFileAs(itk::ImageIOBase* imageIO, const std::string& path) {
-  using Image = itk::Image<T, 3>;
-  auto reader = itk::ImageFileReader<Image>::New();
-  reader->SetFileName(path);
-  reader->SetImageIO(imageIO);
-  reader->Update();
-  ImagePointer<T> image = reader->GetOutput();
-  image->DisconnectPipeline();
+ImagePointer<T> allocatedLike(const InformationImage* information) {
+  auto image = itk::Image<T, 3>::New();
+  image->SetRegions(information->GetLargestPossibleRegion());
+  image->SetSpacing(information->GetSpacing());
+  image->SetOrigin(information->GetOrigin());
+  image->SetDirection(information->GetDirection());
+  image->Allocate();
   return image;
 }
 
+/// The whole of an ImageIO's file, its own dimensions (2D for a 2D file).
+itk::ImageIORegion wholeRegion(const itk::ImageIOBase* imageIO) {
+  itk::ImageIORegion region(imageIO->GetNumberOfDimensions());
+  for (unsigned d = 0; d < imageIO->GetNumberOfDimensions(); ++d) {
+    region.SetIndex(d, 0);
+    region.SetSize(d, imageIO->GetDimensions(d));
+  }
+  return region;
+}
+
+/// What ImageFileReader<Image<T, 3>> reads when T is the file's component type (readWithItk
+/// chooses T so): its output information, and the voxels the ImageIO writes straight into the
+/// image's buffer, as ImageFileReader::GenerateData does in that case. One reader type for all
+/// the pixel types instead of ten keeps ITK's pixel conversions, which surftrack never uses, out
+/// of the build (they took most of this file's compile time).
+template <class T>
+ImagePointer<T> readFileAs(itk::ImageIOBase* imageIO, const std::string& path) {
+  auto reader = itk::ImageFileReader<InformationImage>::New();
+  reader->SetFileName(path);
+  reader->SetImageIO(imageIO);
+  reader->UpdateOutputInformation();
+  ImagePointer<T> image = allocatedLike<T>(reader->GetOutput());
+  imageIO->SetFileName(path);
+  imageIO->SetIORegion(wholeRegion(imageIO));
+  imageIO->Read(image->GetBufferPointer());
+  return image;
+}
+
+/// What ImageSeriesReader<Image<T, 3>> reads: its output information (the slices' positions
+/// give the origin, the spacing between slices and the direction), and each file's voxels after
+/// the previous ones', converted to T (the first file's type) as ITK converts them (a cast) when
+/// a file's own type differs (another rescale slope).
 template <class T>
 ImagePointer<T> readSeriesAs(const std::vector<std::string>& files) {
-  using Image = itk::Image<T, 3>;
-  auto reader = itk::ImageSeriesReader<Image>::New();
   auto dicom = itk::GDCMImageIO::New();
+  auto reader = itk::ImageSeriesReader<InformationImage>::New();
   reader->SetImageIO(dicom);
   reader->SetFileNames(files);
-  reader->Update();
-  ImagePointer<T> image = reader->GetOutput();
-  image->DisconnectPipeline();
+  reader->UpdateOutputInformation();
+  ImagePointer<T> image = allocatedLike<T>(reader->GetOutput());
+  const std::size_t total = image->GetLargestPossibleRegion().GetNumberOfPixels();
+  std::size_t filled = 0;
+  for (const std::string& file : files) {
+    dicom->SetFileName(file);
+    dicom->ReadImageInformation();
+    const itk::ImageIORegion region = wholeRegion(dicom);
+    const std::size_t voxels = region.GetNumberOfPixels();
+    const auto type = scalarTypeOf(dicom->GetComponentType());
+    if (dicom->GetNumberOfComponents() != 1 || !type || voxels > total - filled)
+      throw ReadError("cannot read the DICOM series of '" + files.front() + "': '" + file +
+                      "' does not hold a slice of the series' size and of one scalar a voxel");
+    dicom->SetIORegion(region);
+    T* into = image->GetBufferPointer() + filled;
+    visitScalarType(*type, [&](auto v) {
+      using S = decltype(v);
+      if constexpr (std::is_same_v<S, T>) {
+        dicom->Read(into);
+      } else {
+        std::vector<S> slice(voxels);
+        dicom->Read(slice.data());
+        std::transform(slice.begin(), slice.end(), into, [](S x) { return static_cast<T>(x); });
+      }
+    });
+    filled += voxels;
+  }
+  if (filled != total)
+    throw ReadError("cannot read the DICOM series of '" + files.front() + "': its files hold " +
+                    std::to_string(filled) + " voxels, and its slices announce " + std::to_string(total));
   return image;
 }
 
@@ -668,14 +733,11 @@ ItkHeader readItkHeader(const std::string& path) {
     itk::ImageIOBase::Pointer imageIO = openImageIO(path, header.type, voxels);
     // The reader's output information is the geometry readVolume gives: ImageFileReader pads
     // 2D images to 3D, takes the direction cosines as the matrix's columns, etc.
-    visitScalarType(header.type, [&](auto v) {
-      using Image = itk::Image<decltype(v), 3>;
-      auto reader = itk::ImageFileReader<Image>::New();
-      reader->SetFileName(path);
-      reader->SetImageIO(imageIO);
-      reader->UpdateOutputInformation();
-      std::tie(header.dims, header.geometry) = domainOf(reader->GetOutput(), path);
-    });
+    auto reader = itk::ImageFileReader<InformationImage>::New();  // (readFileAs)
+    reader->SetFileName(path);
+    reader->SetImageIO(imageIO);
+    reader->UpdateOutputInformation();
+    std::tie(header.dims, header.geometry) = domainOf(reader->GetOutput(), path);
     switch (imageIO->GetByteOrder()) {
       case itk::IOByteOrderEnum::BigEndian: header.byteOrder = ItkHeader::ByteOrder::Big; break;
       case itk::IOByteOrderEnum::LittleEndian: header.byteOrder = ItkHeader::ByteOrder::Little; break;

@@ -8,14 +8,11 @@
 #                   SURFTRACK_FUZZ_RUNS=N, N inputs from a fixed seed instead). CI runs this
 #                   with N = 2000 (.ci/run).
 #   sanitize        the whole test suite again, in a build of its own with AddressSanitizer and
-#                   UndefinedBehaviorSanitizer (-DSURFTRACK_SANITIZE=ON; any report fails its
-#                   test). CI runs it last (.ci/run). Measured in CPU time (the 2-core machines
-#                   are shared, so wall-clock figures depend on the others' load): the build
-#                   805 CPU-seconds (416 s), the tests 395 (234 s), on a fresh clone by .ci/run
-#                   with nothing else running (load 1.99).
-#                   Test oracles that are not code under test are compiled without the
-#                   sanitizers (the CGAL checks, test_cli's harness; tests/CMakeLists.txt), and
-#                   io/ReadVolume.cpp, ITK's templates, without UBSan (io/CMakeLists.txt).
+#                   UndefinedBehaviorSanitizer's value checks on the engine
+#                   (-DSURFTRACK_SANITIZE=ON; CMakeLists.txt says which checks and where; any
+#                   report fails its test). CI runs it last (.ci/run); the CPU time of the build
+#                   and of the tests is printed (the machines are shared: wall-clock figures
+#                   depend on the others' load).
 #   all [seconds]   both; the fuzzing, which runs one target at a time on one core, beside the
 #                   sanitized build (its log printed when both are done), then the sanitized
 #                   tests on a machine of their own. CI runs this (.ci/run).

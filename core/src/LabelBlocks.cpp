@@ -7,6 +7,7 @@
 // of the keys for the vertices and of the owning cubes for the triangles, which the merge
 // restores.
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <type_traits>
@@ -68,6 +69,18 @@ std::vector<LabelFragment> scanBlockTyped(const VolumeView& view, Voxel origin, 
   return all;
 }
 
+/// Sorts `v`, made of sorted runs [runs[i], runs[i + 1]), by merging the runs pairwise:
+/// O(n log k) for k runs, and stable (an earlier run's element first on ties), so the result is
+/// exactly std::stable_sort's.
+template <class T, class Less>
+void mergeSortedRuns(std::vector<T>& v, const std::vector<std::size_t>& runs, Less less) {
+  const std::size_t k = runs.size() - 1;
+  for (std::size_t width = 1; width < k; width *= 2)
+    for (std::size_t r = 0; r + width < k; r += 2 * width)
+      std::inplace_merge(v.begin() + std::ptrdiff_t(runs[r]), v.begin() + std::ptrdiff_t(runs[r + width]),
+                         v.begin() + std::ptrdiff_t(runs[std::min(r + 2 * width, k)]), less);
+}
+
 }  // namespace
 
 std::vector<LabelFragment> scanLabelBlock(const VolumeView& view, Voxel origin, Dims volume, Voxel lo, Voxel hi,
@@ -118,28 +131,49 @@ LabelSurface mergeLabelFragments(const std::vector<LabelFragment>& fragments, co
   // single pass numbers them (plane, row, voxel, direction).
   std::vector<std::uint64_t> keys;
   keys.reserve(keyCount);
-  for (const LabelFragment& f : fragments) keys.insert(keys.end(), f.keys.begin(), f.keys.end());
-  std::sort(keys.begin(), keys.end());
+  std::vector<std::size_t> keyRuns{0};
+  for (const LabelFragment& f : fragments) {
+    keys.insert(keys.end(), f.keys.begin(), f.keys.end());
+    keyRuns.push_back(keys.size());
+  }
+  mergeSortedRuns(keys, keyRuns, std::less<>());  // each fragment's keys increase (validKeys)
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   if (keys.size() > std::numeric_limits<std::uint32_t>::max())
     throw InvalidInput("label " + label.text() + " has more than 2^32 - 1 surfels");
 
   // The triangles renumbered, then in the single pass's order: by owning cube (the blocks own
   // disjoint cubes, each fragment in the scan's order), stably, so the table's order within a cube.
-  std::vector<std::pair<std::uint64_t, std::array<std::uint32_t, 3>>> triangles;
+  using OwnedTriangle = std::pair<std::uint64_t, std::array<std::uint32_t, 3>>;
+  const auto byCube = [](const OwnedTriangle& a, const OwnedTriangle& b) { return a.first < b.first; };
+  std::vector<OwnedTriangle> triangles;
   triangles.reserve(triangleCount);
+  std::vector<std::size_t> runs{0};  // each fragment's triangles, [runs[i], runs[i + 1])
+  std::vector<std::uint32_t> global;
   for (const LabelFragment& f : fragments) {
-    std::vector<std::uint32_t> global(f.keys.size());
-    auto at = keys.begin();
-    for (std::size_t v = 0; v < f.keys.size(); ++v) {  // both increasing: one walk
-      at = std::lower_bound(at, keys.end(), f.keys[v]);
-      global[v] = std::uint32_t(at - keys.begin());
+    global.resize(f.keys.size());
+    std::size_t at = 0;
+    for (std::size_t v = 0; v < f.keys.size(); ++v) {  // both increasing: one galloping walk
+      std::size_t step = 1, hi = at;
+      while (hi < keys.size() && keys[hi] < f.keys[v]) {
+        at = hi + 1;
+        hi += step;
+        step *= 2;
+      }
+      at = std::size_t(std::lower_bound(keys.begin() + std::ptrdiff_t(at), keys.begin() + std::ptrdiff_t(std::min(hi, keys.size())),
+                                        f.keys[v]) - keys.begin());
+      global[v] = std::uint32_t(at);
     }
     for (const auto& t : f.triangles)
       triangles.push_back({owningCube({f.keys[t[0]], f.keys[t[1]], f.keys[t[2]]}),
                            {global[t[0]], global[t[1]], global[t[2]]}});
+    // A block's scan meets its cubes in increasing order, so a run is sorted already; stably
+    // sorted here if not, so the merges below give exactly a stable sort of the whole.
+    const auto first = triangles.begin() + std::ptrdiff_t(runs.back());
+    if (!std::is_sorted(first, triangles.end(), byCube)) std::stable_sort(first, triangles.end(), byCube);
+    runs.push_back(triangles.size());
   }
-  std::stable_sort(triangles.begin(), triangles.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  // (An earlier run first on ties: there are none, the blocks' cubes being disjoint.)
+  mergeSortedRuns(triangles, runs, byCube);
 
   LabelSurface out = labelFields(geometry, label, voxels, options);
   Surface& s = out.surface;
