@@ -24,13 +24,17 @@ std::string csvField(const std::string& text) {
 std::string labelTableCsv(const std::vector<LabelRow>& rows) {
   std::ostringstream out;
   const bool smoothed = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.smoothed; });
+  const bool decimated = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.decimated; });
   out << "label,name,voxels,voxel_volume,surfels,triangles,boundaries,euler,genus,area,volume,"
-      << (smoothed ? "volume_before_smoothing,max_vertex_displacement," : "") << "file\n";
+      << (smoothed ? "volume_before_smoothing,max_vertex_displacement," : "")
+      << (decimated ? "triangles_before_decimation,target_triangles,volume_before_decimation," : "") << "file\n";
   for (const LabelRow& r : rows) {
     out << r.label << ',' << csvField(r.name) << ',' << r.voxels << ',' << num(r.voxelVolume, 10) << ','
         << r.surfels << ',' << r.triangles << ',' << r.boundaries << ',' << r.euler << ',' << num(r.genus)
         << ',' << num(r.area, 10) << ',' << num(r.volume, 10) << ',';
     if (smoothed) out << num(r.volumeBeforeSmoothing, 10) << ',' << num(r.maxDisplacement, 10) << ',';
+    if (decimated)
+      out << r.trianglesBeforeDecimation << ',' << r.targetTriangles << ',' << num(r.volumeBeforeDecimation, 10) << ',';
     out << csvField(r.file) << '\n';
   }
   return out.str();
@@ -54,6 +58,11 @@ nlohmann::ordered_json labelTableJson(const std::vector<LabelRow>& rows) {
     if (r.smoothed) {
       table.back()["volume_before_smoothing"] = number(r.volumeBeforeSmoothing);
       table.back()["max_vertex_displacement"] = number(r.maxDisplacement);
+    }
+    if (r.decimated) {
+      table.back()["triangles_before_decimation"] = r.trianglesBeforeDecimation;
+      table.back()["target_triangles"] = r.targetTriangles;
+      table.back()["volume_before_decimation"] = number(r.volumeBeforeDecimation);
     }
   }
   return table;

@@ -25,6 +25,13 @@ struct LabelRow {
   /// move, physical units; the table has their columns only when some row is smoothed.
   bool smoothed = false;
   double volumeBeforeSmoothing = 0, maxDisplacement = 0;
+  /// --max-error, --reduce (shared walls): the triangles and the enclosed volume before the
+  /// decimation (after the smoothing), the triangles --reduce aimed at (0 without it); a
+  /// decimation moves no vertex (the largest move is the smoothing's). Columns only when some
+  /// row is decimated.
+  bool decimated = false;
+  std::size_t trianglesBeforeDecimation = 0, targetTriangles = 0;
+  double volumeBeforeDecimation = 0;
 };
 
 /// The table as CSV: a header line, then one line per row (a field with a comma or a quote is

@@ -1,4 +1,4 @@
-// decimateComplex (ComplexDecimation.h; docs/theory.md §13, "Decimating the complex").
+// decimateComplex (ComplexDecimation.h; docs/theory.md §12, "Decimating the complex").
 #include "ComplexDecimation.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Topology-safe decimation of a conforming complex of shared walls (docs/theory.md §13,
+// Topology-safe decimation of a conforming complex of shared walls (docs/theory.md §12,
 // "Decimating the complex"): the triangles of a label map's complex, each wall once, between
 // two regions. The complex is cut into its walls (the triangles between one ordered pair of
 // regions); a vertex of more than one wall (a junction line), or where some region's triangles

@@ -1,5 +1,5 @@
 // A Decimater module (OpenMesh) for a mesh that is one wall of a conforming complex
-// (ComplexDecimation.h, docs/theory.md §13, "Decimating the complex"): a halfedge collapse
+// (ComplexDecimation.h, docs/theory.md §12, "Decimating the complex"): a halfedge collapse
 // v0 -> v1 of the wall is allowed only if
 //  - v0 is free: all its triangles are of this wall and form one closed disc around it, for both
 //    regions the wall separates (not a junction vertex, not a pinch, not on the wall's border),
