@@ -213,9 +213,12 @@ void checkDecimation(const std::vector<std::uint16_t>& data, Dims dims, bool wit
     EXPECT_EQ(t1.euler, t0.euler) << at;
     EXPECT_EQ(t1.components, t0.components) << at;
     EXPECT_EQ(s.components.size(), s0.components.size()) << at;
-    if (after[l].unsplitEdges == 0) EXPECT_TRUE(t1.manifoldVertices) << at << ": " << t1.problem;
-    if (after[l].unsplitEdges == 0 && after[l].pinchCopies == 0)
+    if (after[l].unsplitEdges == 0) {
+      EXPECT_TRUE(t1.manifoldVertices) << at << ": " << t1.problem;
+    }
+    if (after[l].unsplitEdges == 0 && after[l].pinchCopies == 0) {
       EXPECT_EQ(checks::selfIntersections(s.vertices, s.triangles), 0u) << at;
+    }
     if (decimate.maxError) {
       const double e = *decimate.maxError * (1 + 1e-9);
       EXPECT_LE(checks::sampledDistance(s.vertices, s.triangles, s0.vertices, s0.triangles), e) << at;
