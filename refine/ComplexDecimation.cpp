@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -149,11 +150,26 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
   std::vector<std::uint32_t> version(triangles.size(), 0);
   for (std::uint32_t t = 0; t < triangles.size(); ++t) grid.insert(t, 0, boxOf(triangleOfIndex(t)));
 
-  // 4. Each wall in turn.
-  std::vector<std::uint32_t> stamp(triangles.size(), 0);  // 1 + the wall's index: a triangle of the wall's mesh
-  std::uint32_t wallIndex = 0;
+  // 4. Each wall's mesh and decimater, over the undecimated complex.
+  using Mesh = SurfaceMesh;
+  struct Wall {
+    std::vector<std::uint32_t> ts;
+    std::size_t target = 0, kept = 0, live = 0;  // kept: its triangles outside its mesh
+    Box3 box;
+    std::unique_ptr<Mesh> mesh;
+    OpenMesh::VPropHandleT<std::uint32_t> identity;
+    std::vector<std::uint32_t> triangleOfFace;  // face index -> triangle
+    std::unique_ptr<CheckedDecimaterT<Mesh>> decimater;
+    OpenMesh::Decimater::ModQuadricT<Mesh>::Handle quadric;
+    ModSampledDistanceT<Mesh>::Handle distance;
+    OpenMesh::Decimater::ModNormalFlippingT<Mesh>::Handle flipping;
+    ModTopologyGuardT<Mesh>::Handle topology;
+    ModEmbeddingGuardT<Mesh>::Handle embedding;
+    ModComplexLinkT<Mesh>::Handle link;
+  };
+  std::vector<std::unique_ptr<Wall>> states;  // (the modules' handles cannot be copied)
+  std::vector<std::uint32_t> wallOf(triangles.size(), 0);  // 1 + the index in states of a triangle's wall mesh
   for (const auto& [pair, ts] : walls) {
-    ++wallIndex;
     const std::size_t target =
         p.targetReduction ? std::size_t(std::llround((1 - *p.targetReduction) * double(ts.size()))) : 0;
     report.targetTriangles += target;
@@ -187,25 +203,27 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
     }
     // The mesh; a triangle OpenMesh refuses (a complex vertex it cannot link) stays, with its
     // vertices, and the mesh is made again without it.
-    SurfaceMesh mesh;
-    OpenMesh::VPropHandleT<std::uint32_t> identity;
-    std::vector<std::uint32_t> triangleOfFace;  // face index -> triangle
+    states.push_back(std::make_unique<Wall>());
+    Wall& w = *states.back();
+    w.ts = ts;
+    w.target = target;
     std::vector<std::uint32_t> failedVertices;
     for (bool failed = true; failed;) {
       failed = false;
-      mesh = SurfaceMesh();
-      mesh.add_property(identity);
-      triangleOfFace.clear();
-      std::unordered_map<std::uint32_t, SurfaceMesh::VertexHandle> vertexOfFan;
+      w.mesh = std::make_unique<Mesh>();
+      Mesh& mesh = *w.mesh;
+      mesh.add_property(w.identity);
+      w.triangleOfFace.clear();
+      std::unordered_map<std::uint32_t, Mesh::VertexHandle> vertexOfFan;
       for (std::uint32_t i = 0; i < ts.size() && !failed; ++i) {
         if (!inMesh[i]) continue;
-        std::array<SurfaceMesh::VertexHandle, 3> vh;
+        std::array<Mesh::VertexHandle, 3> vh;
         for (int k = 0; k < 3; ++k) {
           const std::uint32_t root = fans.find(3 * i + std::uint32_t(k)), v = triangles[ts[i]][std::size_t(k)];
           auto [it, added] = vertexOfFan.try_emplace(root);
           if (added) {
-            it->second = mesh.add_vertex(SurfaceMesh::Point(points[v][0], points[v][1], points[v][2]));
-            mesh.property(identity, it->second) = v;
+            it->second = mesh.add_vertex(Mesh::Point(points[v][0], points[v][1], points[v][2]));
+            mesh.property(w.identity, it->second) = v;
           }
           vh[std::size_t(k)] = it->second;
         }
@@ -216,100 +234,114 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
           for (std::uint32_t v : triangles[ts[i]]) failedVertices.push_back(v);
           continue;
         }
-        if (std::size_t(f.idx()) != triangleOfFace.size()) throw std::logic_error("decimateComplex: face numbering");
-        triangleOfFace.push_back(ts[i]);
+        if (std::size_t(f.idx()) != w.triangleOfFace.size()) throw std::logic_error("decimateComplex: face numbering");
+        w.triangleOfFace.push_back(ts[i]);
       }
     }
-    Box3 box = boxOf(triangleOfIndex(ts[0]));
+    Mesh& mesh = *w.mesh;
+    std::vector<char> meshFree(mesh.n_vertices(), 0), meshSingular(mesh.n_vertices(), 0);
+    for (auto v : mesh.vertices()) {
+      const std::uint32_t c = mesh.property(w.identity, v);
+      meshFree[std::size_t(v.idx())] = freeVertex[c] && !mesh.is_boundary(v) && !mesh.is_isolated(v) &&
+                                       std::find(failedVertices.begin(), failedVertices.end(), c) == failedVertices.end();
+      meshSingular[std::size_t(v.idx())] = singular[c];
+    }
+    if (std::none_of(meshFree.begin(), meshFree.end(), [](char c) { return c != 0; })) {
+      states.pop_back();
+      continue;
+    }
+    w.box = boxOf(triangleOfIndex(ts[0]));
     for (std::uint32_t t : ts) {
       const Box3 b = boxOf(triangleOfIndex(t));
       for (int k = 0; k < 3; ++k) {
-        box.lo[k] = std::min(box.lo[k], b.lo[k]);
-        box.hi[k] = std::max(box.hi[k], b.hi[k]);
+        w.box.lo[k] = std::min(w.box.lo[k], b.lo[k]);
+        w.box.hi[k] = std::max(w.box.hi[k], b.hi[k]);
       }
     }
-    for (std::uint32_t t : triangleOfFace) stamp[t] = wallIndex;
-    std::vector<char> meshFree(mesh.n_vertices(), 0), meshSingular(mesh.n_vertices(), 0);
-    for (auto v : mesh.vertices()) {
-      const std::uint32_t c = mesh.property(identity, v);
-      meshFree[std::size_t(v.idx())] = freeVertex[c] && !mesh.is_boundary(v) && !mesh.is_isolated(v);
-      meshSingular[std::size_t(v.idx())] = singular[c];
-    }
-    for (auto v : mesh.vertices())
-      if (std::find(failedVertices.begin(), failedVertices.end(), mesh.property(identity, v)) != failedVertices.end())
-        meshFree[std::size_t(v.idx())] = 0;
-    if (std::none_of(meshFree.begin(), meshFree.end(), [](char c) { return c != 0; })) continue;
-
-    // The obstacles: the complex's triangles near the wall that are not in its mesh.
-    std::vector<Triangle3> obstacles;
-    std::vector<Tri> obstacleNames;
-    const double margin = 1e-6 * edgeLength;
-    const Box3 query{{box.lo[0] - margin, box.lo[1] - margin, box.lo[2] - margin},
-                     {box.hi[0] + margin, box.hi[1] + margin, box.hi[2] + margin}};
-    std::vector<std::uint32_t> near;
-    grid.near(query, [&](std::uint32_t t, std::uint32_t tag) {
-      if (tag == version[t] && !removed[t] && stamp[t] != wallIndex) near.push_back(t);
-    });
-    std::sort(near.begin(), near.end());
-    near.erase(std::unique(near.begin(), near.end()), near.end());
-    for (std::uint32_t t : near) {
-      const Triangle3 x = triangleOfIndex(t);
-      if (!boxOf(x).meets(query)) continue;
-      obstacles.push_back(x);
-      obstacleNames.push_back(triangles[t]);
-    }
-
+    w.kept = ts.size() - mesh.n_faces();
+    w.live = mesh.n_faces();
     mesh.request_vertex_status();
     mesh.request_edge_status();
     mesh.request_halfedge_status();
     mesh.request_face_status();
     mesh.request_face_normals();
     mesh.update_face_normals();
-    {
-      CheckedDecimaterT<SurfaceMesh> decimater(mesh);
-      OpenMesh::Decimater::ModQuadricT<SurfaceMesh>::Handle quadric;
-      ModSampledDistanceT<SurfaceMesh>::Handle distance;
-      OpenMesh::Decimater::ModNormalFlippingT<SurfaceMesh>::Handle flipping;
-      ModTopologyGuardT<SurfaceMesh>::Handle topology;
-      ModEmbeddingGuardT<SurfaceMesh>::Handle embedding;
-      ModComplexLinkT<SurfaceMesh>::Handle link;
-      decimater.add(quadric);
-      decimater.add(flipping);
-      decimater.add(link);  // (first of the guards: the cheapest refusals)
-      decimater.add(topology);
-      decimater.add(embedding);
-      decimater.module(quadric).unset_max_err();
-      if (p.maxError) {
-        decimater.module(quadric).set_max_err(*p.maxError * *p.maxError, false);
-        decimater.add(distance);
-        decimater.module(distance).set_tolerance(*p.maxError);
-      }
-      decimater.module(flipping).set_max_normal_deviation(p.maxNormalDeviation);
-      decimater.module(link).set_complex(identity, std::move(meshFree), std::move(meshSingular), &incidence);
-      decimater.module(embedding).set_complex(identity, std::move(obstacles), std::move(obstacleNames));
-      if (!decimater.initialize()) throw std::logic_error("decimateComplex: the decimater refused its modules");
-      const std::size_t kept = ts.size() - mesh.n_faces();  // the wall's triangles outside its mesh
-      auto& quadricModule = decimater.module(quadric);
-      decimater.decimateToFaces(
-          target > kept ? target - kept : 0, [&](const auto& ci) { return quadricModule.collapse_priority(ci); },
-          p.cancel);
+    w.decimater = std::make_unique<CheckedDecimaterT<Mesh>>(mesh);
+    CheckedDecimaterT<Mesh>& decimater = *w.decimater;
+    decimater.add(w.quadric);
+    decimater.add(w.flipping);
+    decimater.add(w.link);  // (first of the guards: the cheapest refusals)
+    decimater.add(w.topology);
+    decimater.add(w.embedding);
+    decimater.module(w.quadric).unset_max_err();
+    if (p.maxError) {
+      decimater.module(w.quadric).set_max_err(*p.maxError * *p.maxError, false);
+      decimater.add(w.distance);
+      decimater.module(w.distance).set_tolerance(*p.maxError);
     }
-    // The wall's triangles written back: the survivors' vertices, in their orientation.
-    for (auto f : mesh.all_faces()) {
-      const std::uint32_t t = triangleOfFace[std::size_t(f.idx())];
-      if (mesh.status(f).deleted()) {
-        removed[t] = 1;
-        ++version[t];
-        continue;
-      }
-      Tri now;
-      int k = 0;
-      for (auto v : mesh.fv_range(f)) now[std::size_t(k++)] = mesh.property(identity, v);
-      if (ComplexIncidence::triangleKey(now) == ComplexIncidence::triangleKey(triangles[t])) continue;
-      triangles[t] = now;
-      grid.insert(t, ++version[t], boxOf(triangleOfIndex(t)));
-    }
+    decimater.module(w.flipping).set_max_normal_deviation(p.maxNormalDeviation);
+    decimater.module(w.link).set_complex(w.identity, std::move(meshFree), std::move(meshSingular), &incidence);
+    decimater.module(w.embedding).set_complex(w.identity);
+    if (!decimater.initialize()) throw std::logic_error("decimateComplex: the decimater refused its modules");
+    for (std::uint32_t t : w.triangleOfFace) wallOf[t] = std::uint32_t(states.size());
   }
+
+  // 5. The walls decimated in rounds, each wall a part of the way to its target in each round,
+  //    so that no wall takes every chord between junction vertices before the next one starts
+  //    (the link condition over the complex refuses a chord twice).
+  constexpr int kRounds = 4;
+  for (int round = 1; round <= kRounds; ++round)
+    for (std::size_t k = 0; k < states.size(); ++k) {
+      Wall& w = *states[k];
+      Mesh& mesh = *w.mesh;
+      const std::size_t n = w.ts.size();
+      const std::size_t goal = n - (n - std::min(n, w.target)) * std::size_t(round) / kRounds;
+      const std::size_t meshGoal = goal > w.kept ? goal - w.kept : 0;
+      if (w.live <= meshGoal) continue;
+      throwIfCancelled(p.cancel, "decimation");
+      // The obstacles: the complex's triangles near the wall that are not in its mesh, now.
+      std::vector<Triangle3> obstacles;
+      std::vector<Tri> obstacleNames;
+      const double margin = 1e-6 * edgeLength;
+      const Box3 query{{w.box.lo[0] - margin, w.box.lo[1] - margin, w.box.lo[2] - margin},
+                       {w.box.hi[0] + margin, w.box.hi[1] + margin, w.box.hi[2] + margin}};
+      std::vector<std::uint32_t> near;
+      grid.near(query, [&](std::uint32_t t, std::uint32_t tag) {
+        if (tag == version[t] && !removed[t] && wallOf[t] != k + 1) near.push_back(t);
+      });
+      std::sort(near.begin(), near.end());
+      near.erase(std::unique(near.begin(), near.end()), near.end());
+      for (std::uint32_t t : near) {
+        const Triangle3 x = triangleOfIndex(t);
+        if (!boxOf(x).meets(query)) continue;
+        obstacles.push_back(x);
+        obstacleNames.push_back(triangles[t]);
+      }
+      w.decimater->module(w.embedding).set_obstacles(std::move(obstacles), std::move(obstacleNames));
+      auto& quadricModule = w.decimater->module(w.quadric);
+      // (n_faces() counts the faces deleted in earlier rounds too.)
+      const std::size_t deleted = mesh.n_faces() - w.live;
+      w.decimater->decimateToFaces(
+          meshGoal + deleted, [&](const auto& ci) { return quadricModule.collapse_priority(ci); }, p.cancel);
+      // The wall's triangles written back: the survivors' vertices, in their orientation.
+      w.live = 0;
+      for (auto f : mesh.all_faces()) {
+        const std::uint32_t t = w.triangleOfFace[std::size_t(f.idx())];
+        if (removed[t]) continue;
+        if (mesh.status(f).deleted()) {
+          removed[t] = 1;
+          ++version[t];
+          continue;
+        }
+        ++w.live;
+        Tri now;
+        int c = 0;
+        for (auto v : mesh.fv_range(f)) now[std::size_t(c++)] = mesh.property(w.identity, v);
+        if (ComplexIncidence::triangleKey(now) == ComplexIncidence::triangleKey(triangles[t])) continue;
+        triangles[t] = now;
+        grid.insert(t, ++version[t], boxOf(triangleOfIndex(t)));
+      }
+    }
   report.trianglesAfter = std::size_t(std::count(removed.begin(), removed.end(), 0));
   return report;
 }

@@ -35,22 +35,24 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
 
   explicit ModEmbeddingGuardT(MeshT& mesh) : Base(mesh, true) {}
 
-  /// The mesh is one part of a complex: `identity` holds each vertex's name in the complex;
-  /// `obstacles` are the complex's other triangles (fixed while this mesh is decimated) and
-  /// `obstacleNames` their vertices' names. Before initialize().
-  void set_complex(OpenMesh::VPropHandleT<std::uint32_t> identity, std::vector<Triangle3> obstacles,
-                   std::vector<std::array<std::uint32_t, 3>> obstacleNames) {
-    identity_ = identity;
-    obstacles_ = std::move(obstacles);
-    obstacleNames_ = std::move(obstacleNames);
-  }
+  /// The mesh is one part of a complex: `identity` holds each vertex's name in the complex.
+  /// Before initialize().
+  void set_complex(OpenMesh::VPropHandleT<std::uint32_t> identity) { identity_ = identity; }
 
   void initialize() override {
     const MeshT& m = Base::mesh();
-    tolerance_ = 1e-9 * 2 * meanEdgeLength(m);
+    cell_ = 2 * meanEdgeLength(m);
+    tolerance_ = 1e-9 * cell_;
     grid_.build(m, 0);
+  }
+
+  /// The complex's other triangles (`obstacles`, fixed while this mesh is decimated) and their
+  /// vertices' names. After initialize(), and again whenever they change.
+  void set_obstacles(std::vector<Triangle3> obstacles, std::vector<std::array<std::uint32_t, 3>> obstacleNames) {
+    obstacles_ = std::move(obstacles);
+    obstacleNames_ = std::move(obstacleNames);
     if (obstacles_.empty()) return;
-    Box3 bounds = LiveTriangleGrid<MeshT>::boundsOf(m);
+    Box3 bounds = LiveTriangleGrid<MeshT>::boundsOf(Base::mesh());
     for (const Triangle3& t : obstacles_) {
       const Box3 b = boxOf(t);
       for (int k = 0; k < 3; ++k) {
@@ -58,7 +60,7 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
         bounds.hi[k] = std::max(bounds.hi[k], b.hi[k]);
       }
     }
-    obstacleGrid_.reset(bounds, 2 * meanEdgeLength(m));
+    obstacleGrid_.reset(bounds, cell_);
     for (std::size_t i = 0; i < obstacles_.size(); ++i)
       obstacleGrid_.insert(std::uint32_t(i), 0, boxOf(obstacles_[i], tolerance_));
     obstacleMark_.assign(obstacles_.size(), 0);
@@ -138,7 +140,7 @@ class ModEmbeddingGuardT : public OpenMesh::Decimater::ModBaseT<MeshT> {
     return false;
   }
 
-  double tolerance_ = 1e-9;
+  double tolerance_ = 1e-9, cell_ = 1;
   LiveTriangleGrid<MeshT> grid_;
   std::vector<Face> created_;
   std::vector<std::uint64_t> mark_;
