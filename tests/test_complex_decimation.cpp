@@ -265,7 +265,7 @@ auto priorities(const std::vector<std::uint16_t>& data, Dims dims, bool withBack
 TEST(ComplexDecimation, RandomLabelImages) {
   std::mt19937_64 rng(5151);
   Stats stats;
-  for (int image = 0; image < 120; ++image) {
+  for (int image = 0; image < 80; ++image) {
     std::uniform_int_distribution<int> side(2, 5);
     const Dims dims{side(rng), side(rng), side(rng)};
     const int count = std::uniform_int_distribution<int>(2, image % 4 == 0 ? 40 : 6)(rng);
@@ -280,7 +280,7 @@ TEST(ComplexDecimation, RandomLabelImages) {
                     priorities(data, dims, withBackground), "image " + std::to_string(image), stats);
     if (::testing::Test::HasFatalFailure()) return;
   }
-  EXPECT_GE(stats.images, testing::subsetMinimum(120));
+  EXPECT_GE(stats.images, testing::subsetMinimum(80));
   EXPECT_LT(stats.after, stats.before);
   std::cout << "[ study ] " << stats.images << " random images, " << stats.labels << " labels: triangles "
             << stats.before << " -> " << stats.after << "\n";
@@ -290,12 +290,12 @@ TEST(ComplexDecimation, BlownUpCubePatterns) {
   // Patterns of one digital 3-cube (tests/LabelPatterns.h), each corner a block of k^3 voxels:
   // flat walls meeting on junction lines and pinches, the outside the background.
   const std::vector<testing::Ranks> patterns = testing::allPriorityPatterns();
-  const int k = 5;
+  const int k = 4;
   const Dims dims{2 * k, 2 * k, 2 * k};
   Stats reduced, bounded;
   std::size_t checked = 0;
-  for (std::size_t c = 7; c < patterns.size(); c += 19997) {
-    if (!caseChecked(c / 19997)) continue;
+  for (std::size_t c = 7; c < patterns.size(); c += 39989) {
+    if (!caseChecked(c / 39989)) continue;
     ++checked;
     std::vector<std::uint16_t> data(std::size_t(dims.nx) * std::size_t(dims.ny) * std::size_t(dims.nz));
     for (int z = 0, i = 0; z < dims.nz; ++z)
@@ -314,7 +314,7 @@ TEST(ComplexDecimation, BlownUpCubePatterns) {
                     "pattern " + std::to_string(c) + " max error", bounded);
     if (::testing::Test::HasFatalFailure()) return;
   }
-  EXPECT_GE(checked, testing::subsetMinimum(27));
+  EXPECT_GE(checked, testing::subsetMinimum(14));
   std::cout << "[ study ] " << checked << " blown-up cube patterns, reduce 0.8: triangles " << reduced.before << " -> "
             << reduced.after << " (labels' target " << reduced.target << "); the complex " << reduced.complexBefore
             << " -> " << reduced.complexAfter << " (" << reduced.reachable
