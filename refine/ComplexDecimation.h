@@ -30,12 +30,13 @@ struct ComplexDecimationReport {
   std::size_t lockedVertices = 0;   ///< vertices on junction lines or pinches
 };
 
-/// Decimates the complex of `triangles` over `points` (physical) in place: triangles[t] is
-/// the wall between regions sides[t][0] (its triangles turn their front to it... as the caller
-/// orients them) and sides[t][1]; on return removed[t] says whether triangle t is gone, and
-/// triangles[t] holds the survivors' vertices (a removed vertex replaced by the one it went
-/// into; the orientation kept). A vertex that is not locked has its triangles in one wall only.
-/// parameters.grid is not used; a reduction applies to each wall.
+/// Decimates the complex of `triangles` over `points` (physical) in place: triangle t lies on
+/// the wall between regions sides[t][0] and sides[t][1] (an ordered pair: the triangles of one
+/// wall are oriented alike); on return removed[t] says whether triangle t is gone, and
+/// triangles[t] holds a survivor's vertices (a removed vertex replaced by the one it went into;
+/// the orientation kept). The walls are decimated in rounds, each wall a part of the way to its
+/// target in each (see ComplexDecimation.cpp). parameters.grid is not used; a reduction applies
+/// to each wall, as far as its locked vertices and the guards allow.
 /// \throw std::invalid_argument for parameters out of range (decimateSafely's), sizes that
 ///        differ or a vertex index out of range; Cancelled when parameters.cancel is raised.
 ComplexDecimationReport decimateComplex(const std::vector<Point3>& points,

@@ -221,7 +221,7 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
                        "vertices it shares with its neighbours apart (docs/theory.md §12)");
   if (o.decimate && o.walls != LabelWalls::Shared)
     throw InvalidInput("decimating a label map needs shared walls: each label decimated on its own would no "
-                       "longer share its walls with its neighbours (docs/theory.md §12, "Decimating the complex")");
+                       "longer share its walls with its neighbours (docs/theory.md §12)");
   if (o.walls == LabelWalls::Shared) {
     if (fromSeeds || o.boundaries != LabelBoundaries::All)
       throw InvalidInput("shared walls partition the whole image: every boundary of every label, no seeds or largest");
