@@ -26,14 +26,18 @@ std::string labelTableCsv(const std::vector<LabelRow>& rows) {
   const bool smoothed = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.smoothed; });
   const bool tree = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.mergeLevels >= 0; });
   const bool missing = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return !r.noFile.empty(); });
+  const bool decimated = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.decimated; });
   out << "label,name,voxels,voxel_volume,surfels,triangles,boundaries,euler,genus,area,volume,"
-      << (smoothed ? "volume_before_smoothing,max_vertex_displacement," : "") << "file"
+      << (smoothed ? "volume_before_smoothing,max_vertex_displacement," : "")
+      << (decimated ? "triangles_before_decimation,target_triangles,volume_before_decimation," : "") << "file"
       << (tree ? ",merge_levels" : "") << (missing ? ",no_file" : "") << "\n";
   for (const LabelRow& r : rows) {
     out << r.label << ',' << csvField(r.name) << ',' << r.voxels << ',' << num(r.voxelVolume, 10) << ','
         << r.surfels << ',' << r.triangles << ',' << r.boundaries << ',' << r.euler << ',' << num(r.genus)
         << ',' << num(r.area, 10) << ',' << num(r.volume, 10) << ',';
     if (smoothed) out << num(r.volumeBeforeSmoothing, 10) << ',' << num(r.maxDisplacement, 10) << ',';
+    if (decimated)
+      out << r.trianglesBeforeDecimation << ',' << r.targetTriangles << ',' << num(r.volumeBeforeDecimation, 10) << ',';
     out << csvField(r.file);
     if (tree) out << ',' << (r.mergeLevels >= 0 ? std::to_string(r.mergeLevels) : std::string());
     if (missing) out << ',' << csvField(r.noFile);
@@ -60,6 +64,11 @@ nlohmann::ordered_json labelTableJson(const std::vector<LabelRow>& rows) {
     if (r.smoothed) {
       table.back()["volume_before_smoothing"] = number(r.volumeBeforeSmoothing);
       table.back()["max_vertex_displacement"] = number(r.maxDisplacement);
+    }
+    if (r.decimated) {
+      table.back()["triangles_before_decimation"] = r.trianglesBeforeDecimation;
+      table.back()["target_triangles"] = r.targetTriangles;
+      table.back()["volume_before_decimation"] = number(r.volumeBeforeDecimation);
     }
     if (r.mergeLevels >= 0) table.back()["merge_levels"] = r.mergeLevels;
     if (!r.noFile.empty()) table.back()["no_file"] = r.noFile;

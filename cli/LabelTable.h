@@ -31,6 +31,13 @@ struct LabelRow {
   /// The table has the merge_levels and no_file columns only when some row needs them.
   int mergeLevels = -1;
   std::string noFile;
+  /// --max-error, --reduce (shared walls): the triangles and the enclosed volume before the
+  /// decimation (after the smoothing), the triangles --reduce aimed at (0 without it); a
+  /// decimation moves no vertex (the largest move is the smoothing's). Columns only when some
+  /// row is decimated.
+  bool decimated = false;
+  std::size_t trianglesBeforeDecimation = 0, targetTriangles = 0;
+  double volumeBeforeDecimation = 0;
 };
 
 /// The table as CSV: a header line, then one line per row (a field with a comma or a quote is

@@ -142,6 +142,12 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
     so.threads = o.threads;
     options.smooth = so;
   }
+  if (o.maxError || o.reduction) {  // the complex's decimation (docs/theory.md §12, "Decimating the complex")
+    DecimateOptions d;
+    d.maxError = o.maxError;
+    d.reduction = o.reduction;
+    options.decimate = d;
+  }
   const std::vector<LabelSurface> surfaces = extractLabels(view, options);
   if (!o.out.quiet)
     for (const LabelSurface& l : surfaces)
@@ -172,6 +178,12 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
       r.smoothed = true;
       r.volumeBeforeSmoothing = ls.smooth->volumeBefore;
       r.maxDisplacement = ls.smooth->maxDisplacement;
+    }
+    if (ls.decimate) {
+      r.decimated = true;
+      r.trianglesBeforeDecimation = ls.decimate->trianglesBefore;
+      r.targetTriangles = ls.decimate->targetTriangles;
+      r.volumeBeforeDecimation = ls.decimate->volumeBefore;
     }
     if (precomputed) {
       // The segment's manifest (unsharded; sharded, the shard file holds it).
@@ -232,6 +244,8 @@ int runLabels(const std::vector<std::string>& args) {
     j["adjacency"] = toString(o.pair);
     j["walls"] = o.walls;
     if (o.smoothIterations > 0) j["smooth_iterations"] = o.smoothIterations;
+    if (o.maxError) j["max_error"] = number(*o.maxError);
+    if (o.reduction) j["reduce"] = number(*o.reduction);
     j["labels"] = labelTableJson(rows);
     nlohmann::ordered_json t = nlohmann::ordered_json::object();
     for (const StageTiming& s : run.timings) t[s.name] = number(s.seconds);

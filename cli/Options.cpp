@@ -819,6 +819,20 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
                ", got '" + s + "'";
       }))
       ->group(which);
+  addValue(
+      app, "--max-error", "E", [&o](const std::string& s) { o.maxError = *toNumber(s); },
+      "with --walls shared: decimate the complex, each wall once, within E\n(physical units) of the "
+      "undecimated walls; walls still shared, junction\nlines and each label's topology kept")
+      ->check(explained(CLI::PositiveNumber, "--max-error takes a positive distance"))
+      ->group(which);
+  addValue(
+      app, "--reduce", "F", [&o](const std::string& s) { o.reduction = *toNumber(s); },
+      "with --walls shared: decimate the complex, removing the fraction F in\n[0, 1) of each wall's "
+      "triangles (as far as --max-error, the junction\nlines and the topology allow)")
+      ->check(explained(CLI::Range(0.0, 0.999999), [](const std::string& s) {
+        return "--reduce takes a fraction in [0, 1), got '" + s + "'";
+      }))
+      ->group(which);
   addDaskOptions(app, o.dask, args.block, o.workDir, "by blocks on Dask (a chunked store, -o DIR/)",
                  "the same files and table as the single pass");
   addValue(app, "--merge-budget", "B", [&o](const std::string& s) { o.mergeBudget = *toByteCount(s); },
@@ -945,6 +959,11 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   if (o.mergeBudget && !o.format.empty())
     throw UsageError("--merge-budget is for mesh files: not with --format (Neuroglancer's formats hold every label's "
                      "mesh)");
+  if ((o.maxError || o.reduction) && o.walls != "shared")
+    throw UsageError("--max-error and --reduce on labels need --walls shared: each label decimated on its own "
+                     "would no longer share its walls with its neighbours");
+  if ((o.maxError || o.reduction) && !o.dask.empty())
+    throw UsageError("--max-error and --reduce are not made by blocks: no --dask");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
   if (!o.unit.empty() && o.format.empty()) throw UsageError("--unit is for --format precomputed or precomputed-multires");
   checkPrecomputedOptions(app, o.format, o.output);

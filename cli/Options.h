@@ -128,6 +128,8 @@ struct LabelsOptions {
   AdjacencyPair pair = AdjacencyPair::k26_6;
   std::string walls = "independent";               ///< --walls independent|shared
   int smoothIterations = 0;                        ///< --smooth [N] (shared walls): 0 none
+  std::optional<double> maxError;                  ///< --max-error E (shared walls): decimation
+  std::optional<double> reduction;                 ///< --reduce F (shared walls): decimation
   int threads = 0;
   bool ascii = false;
   std::string table;  ///< --table FILE.csv | FILE.json

@@ -15,7 +15,7 @@
 
 namespace surftrack::refine {
 
-DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p) {
+void requireDecimationParameters(const DecimationParameters& p) {
   std::ostringstream msg;
   if (p.maxError && !(*p.maxError > 0 && std::isfinite(*p.maxError)))
     msg << "decimation max error " << *p.maxError << " is not a positive distance";
@@ -24,6 +24,10 @@ DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p
   else if (!(p.maxNormalDeviation > 0 && p.maxNormalDeviation <= 180))
     msg << "decimation normal deviation " << p.maxNormalDeviation << " is outside ]0, 180]";
   if (!msg.str().empty()) throw std::invalid_argument(msg.str());
+}
+
+DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p) {
+  requireDecimationParameters(p);
   for (auto h : mesh.halfedges())
     if (mesh.is_boundary(h)) throw std::invalid_argument("decimation needs a closed mesh: it has a boundary edge");
 

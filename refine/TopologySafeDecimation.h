@@ -41,6 +41,9 @@ struct DecimationReport {
   std::size_t targetTriangles = 0;  ///< what targetReduction asked for (0: no target)
 };
 
+/// \throw std::invalid_argument naming the first of `parameters` out of range.
+void requireDecimationParameters(const DecimationParameters& parameters);
+
 /// Decimates `mesh` in place (a closed 2-manifold; vertex properties such as the surfels follow
 /// the surviving vertices), then collects the garbage.
 /// \throw std::invalid_argument for parameters out of range or a mesh with a boundary;

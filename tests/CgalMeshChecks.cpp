@@ -6,7 +6,9 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/intersections.h>
 
+#include <algorithm>
 #include <iterator>
 #include <utility>
 
@@ -53,6 +55,46 @@ std::size_t selfIntersections(const Points& points, const Triangles& triangles) 
   std::vector<std::pair<CgalMesh::Face_index, CgalMesh::Face_index>> pairs;
   CGAL::Polygon_mesh_processing::self_intersections(m, std::back_inserter(pairs));
   return pairs.size();
+}
+
+std::size_t soupIntersections(const Points& points, const Triangles& triangles) {
+  using P = Kernel::Point_3;
+  std::vector<CGAL::Bbox_3> boxes;
+  for (const auto& t : triangles)
+    boxes.push_back(cgalPoint(points[t[0]]).bbox() + cgalPoint(points[t[1]]).bbox() + cgalPoint(points[t[2]]).bbox());
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < triangles.size(); ++i)
+    for (std::size_t j = i + 1; j < triangles.size(); ++j) {
+      if (!CGAL::do_overlap(boxes[i], boxes[j])) continue;
+      const auto &a = triangles[i], &b = triangles[j];
+      std::vector<std::uint32_t> shared;
+      for (std::uint32_t v : a)
+        if (std::find(b.begin(), b.end(), v) != b.end()) shared.push_back(v);
+      auto other = [&](const std::array<std::uint32_t, 3>& t) {
+        std::vector<P> out;
+        for (std::uint32_t v : t)
+          if (std::find(shared.begin(), shared.end(), v) == shared.end()) out.push_back(cgalPoint(points[v]));
+        return out;
+      };
+      const Kernel::Triangle_3 ta(cgalPoint(points[a[0]]), cgalPoint(points[a[1]]), cgalPoint(points[a[2]]));
+      const Kernel::Triangle_3 tb(cgalPoint(points[b[0]]), cgalPoint(points[b[1]]), cgalPoint(points[b[2]]));
+      bool meet = false;
+      if (shared.size() == 3) {
+        meet = true;
+      } else if (shared.size() == 2) {
+        const P p = cgalPoint(points[shared[0]]), q = cgalPoint(points[shared[1]]);
+        const P r = other(a)[0], s = other(b)[0];
+        meet = CGAL::coplanar(p, q, r, s) && CGAL::coplanar_orientation(p, q, r, s) == CGAL::POSITIVE;
+      } else if (shared.size() == 1) {
+        const auto oa = other(a), ob = other(b);
+        meet = CGAL::do_intersect(Kernel::Segment_3(oa[0], oa[1]), tb) ||
+               CGAL::do_intersect(Kernel::Segment_3(ob[0], ob[1]), ta);
+      } else {
+        meet = CGAL::do_intersect(ta, tb);
+      }
+      count += meet;
+    }
+  return count;
 }
 
 double sampledDistance(const Points& pa, const Triangles& ta, const Points& pb, const Triangles& tb) {

@@ -22,6 +22,13 @@ using Triangles = std::vector<std::array<std::uint32_t, 3>>;
 /// exact predicates).
 std::size_t selfIntersections(const Points& points, const Triangles& triangles);
 
+/// The pairs of triangles of a soup (any number of triangles on an edge, as a label map's
+/// complex) that meet other than in the vertices they share by index: a repeated triangle; two
+/// on a shared edge, coplanar, on the same side of it; two with a shared vertex whose opposite
+/// edge meets the other one; two with nothing shared that meet (CGAL, exact predicates).
+/// Brute force over the pairs whose boxes meet: for small complexes.
+std::size_t soupIntersections(const Points& points, const Triangles& triangles);
+
 /// The largest distance from samples of mesh a to mesh b (CGAL's AABB tree): vertices, edge
 /// midpoints, centroids and the points of barycentric coordinates (4, 1, 1) / 6 and its
 /// rotations of every triangle of a.

@@ -94,6 +94,8 @@ std::vector<LabelFragment> scanLabelBlock(const VolumeView& view, Voxel origin, 
   if (options.walls != LabelWalls::Independent)
     throw InvalidInput("a block scan gives independent walls only: shared walls are not split into blocks yet");
   if (options.smooth) throw InvalidInput("a block scan does not smooth: smoothing needs the whole complex (shared walls)");
+  if (options.decimate)
+    throw InvalidInput("a block scan does not decimate: decimation needs the whole complex (shared walls)");
   if (options.boundaries != LabelBoundaries::All)
     throw InvalidInput("a block scan meshes every boundary: the largest is a property of the whole volume");
   makeViewSource(view);  // checks the view

@@ -219,6 +219,9 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
   if (o.smooth && o.walls != LabelWalls::Shared)
     throw InvalidInput("smoothing a label map needs shared walls: each label smoothed on its own would pull the "
                        "vertices it shares with its neighbours apart (docs/theory.md §12)");
+  if (o.decimate && o.walls != LabelWalls::Shared)
+    throw InvalidInput("decimating a label map needs shared walls: each label decimated on its own would no "
+                       "longer share its walls with its neighbours (docs/theory.md §12)");
   if (o.walls == LabelWalls::Shared) {
     if (fromSeeds || o.boundaries != LabelBoundaries::All)
       throw InvalidInput("shared walls partition the whole image: every boundary of every label, no seeds or largest");

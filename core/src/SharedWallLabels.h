@@ -7,11 +7,15 @@
 // touches itself at a vertex or an edge the pinch is split (converter/PinchSplit.h) and counted.
 // With LabelOptions::smooth the scan also keeps the complex itself (every wall once, over one
 // vertex per surfel), which is smoothed as a whole (ComplexSmoothing.h); each label's vertex
-// then takes its complex vertex's point, so a vertex has one point in every label.
+// then takes its complex vertex's point, so a vertex has one point in every label. With
+// LabelOptions::decimate the complex (smoothed or not) is decimated wall by wall
+// (WallDecimation.h), and each label's triangles are its walls' survivors, over its own vertices
+// (a pinch's copies kept where they were: the decimation never touches a pinch).
 // One thread for the scan; the labels' meshes are the same for any `threads`.
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <unordered_map>
@@ -28,6 +32,7 @@
 #include "PinchSplit.h"
 #include "ScannedLabel.h"
 #include "SourceImage.h"
+#include "WallDecimation.h"
 
 namespace surftrack {
 
@@ -71,17 +76,21 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     std::unordered_map<std::uint64_t, std::uint32_t> vertexOf;  // grid edge key -> vertex
     std::vector<Surfel> surfels;
     std::vector<std::array<std::uint32_t, 3>> triangles;
-    std::vector<std::uint32_t> complexVertex;  // with smoothing: each vertex's in the complex
+    std::vector<std::uint32_t> complexVertex;  // with smoothing or decimation: each vertex's in the complex
+    std::vector<std::uint32_t> complexTriangle;  // with decimation: each triangle's in the complex
+    std::vector<char> reversed;                  // ... and whether it is that one reversed
   };
   // The complex, with smoothing only: every wall once, as the cube gives it (from its higher
   // priority to its lower), over one vertex per grid edge, its surfel oriented from its voxel of
   // higher priority; the walls of every label, selected or not, so that the smoothed points do
   // not depend on the selection.
-  const bool smoothing = o.smooth.has_value();
+  const bool smoothing = o.smooth.has_value(), decimating = o.decimate.has_value();
+  const bool keepComplex = smoothing || decimating;
   struct Complex {
     std::unordered_map<std::uint64_t, std::uint32_t> vertexOf;
     std::vector<Surfel> surfels;
     std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<std::array<std::uint32_t, 2>> sides;  // each triangle's (inside, outside) priorities
   } complex;
   // The vertex of cube m's edge in a vertex map keyed by grid edge, and whether it is new; a new
   // one gets its surfel from its low voxel where fromLow(priority low, priority high) says so,
@@ -111,7 +120,7 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     const auto [v, added] = vertexOfEdge(b.vertexOf, b.surfels, m, edge, [&](std::uint32_t pl, std::uint32_t ph) {
       return pl == label || (ph != label && pl > ph);
     });
-    if (added && smoothing) b.complexVertex.push_back(complexVertex(m, edge));
+    if (added && keepComplex) b.complexVertex.push_back(complexVertex(m, edge));
     return v;
   };
   for (int z = -1; z < dims.nz; ++z)
@@ -135,9 +144,11 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
         const CubeWalls& walls = at->second;
         for (int w = 0; w < walls.count; ++w) {
           const WallTriangle& t = walls.triangles[std::size_t(w)];
-          if (smoothing)
+          if (keepComplex) {
             complex.triangles.push_back(
                 {complexVertex(m, t.edges[0]), complexVertex(m, t.edges[1]), complexVertex(m, t.edges[2])});
+            complex.sides.push_back({distinct[t.inside], distinct[t.outside]});
+          }
           for (const bool reversed : {false, true}) {
             const std::uint32_t label = distinct[reversed ? t.outside : t.inside];
             if (slot[label] < 0) continue;
@@ -146,20 +157,34 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
                                              vertex(b, label, m, t.edges[2])};
             if (reversed) std::swap(tri[1], tri[2]);
             b.triangles.push_back(tri);
+            if (decimating) {
+              b.complexTriangle.push_back(std::uint32_t(complex.triangles.size() - 1));
+              b.reversed.push_back(char(reversed));
+            }
           }
         }
       }
 
-  // 3. With smoothing, the complex smoothed from the midpoint mapping (then the geometry).
+  // 3. With smoothing, the complex smoothed from the midpoint mapping (then the geometry); with
+  //    decimation, the complex decimated (after the smoothing).
   const ImageGeometry geometry = source.geometry();
   const bool mirrored = geometry.handedness() < 0;
   std::vector<refine::Point3> smoothed;
   SmoothReport complexReport;
-  if (smoothing) {
-    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+  if (keepComplex) {
     smoothed.resize(complex.surfels.size());
     for (std::size_t v = 0; v < smoothed.size(); ++v) smoothed[v] = geometry.toPhysical(MidpointMapping{}(complex.surfels[v]));
+  }
+  if (smoothing) {
+    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
     complexReport = smoothComplex(smoothed, complex.surfels, complex.triangles, geometry, *o.smooth, o.cancel);
+  }
+  std::vector<std::array<std::uint32_t, 3>> undecimated;  // the complex's triangles before
+  std::vector<char> removed;
+  if (decimating) {
+    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+    undecimated = complex.triangles;
+    decimateWalls(smoothed, complex.triangles, complex.sides, removed, *o.decimate, o.cancel);
   }
 
   // 4. Pinches split, vertices placed (midpoint mapping, then the geometry, or the smoothed
@@ -202,6 +227,62 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
       }
       result.smooth = report;
     }
+    if (decimating) {
+      // Each label triangle from its complex triangle's survivor: a corner the collapses kept
+      // is the label's vertex it was (a pinch's copy included), a new one (a vertex a removed
+      // one went into, never a pinch) the label's vertex of that complex vertex.
+      DecimateReport report;
+      report.trianglesBefore = s.triangles.size();
+      if (o.decimate->reduction)
+        report.targetTriangles = std::size_t(std::llround((1 - *o.decimate->reduction) * double(s.triangles.size())));
+      for (const ComponentFigures& c : componentFigures(s.vertices, s.triangles)) report.volumeBefore += c.volume;
+      if (mirrored) report.volumeBefore = -report.volumeBefore;
+      std::unordered_map<std::uint32_t, std::uint32_t> vertexOfComplex;
+      const std::size_t originals = s.surfels.size() - split.copyOf.size();
+      for (std::size_t v = 0; v < originals; ++v) vertexOfComplex.emplace(b.complexVertex[v], std::uint32_t(v));
+      std::vector<std::array<std::uint32_t, 3>> kept;
+      kept.reserve(s.triangles.size());
+      for (std::size_t i = 0; i < s.triangles.size(); ++i) {
+        const std::uint32_t c = b.complexTriangle[i];
+        if (removed[c]) continue;
+        const auto& was = undecimated[c];
+        const auto& now = complex.triangles[c];
+        std::array<std::uint32_t, 3> t;
+        for (int k = 0; k < 3; ++k) {
+          const auto at = std::find(was.begin(), was.end(), now[std::size_t(k)]);
+          if (at != was.end()) {
+            int j = int(at - was.begin());
+            if (b.reversed[i] && j) j = 3 - j;  // (the label's triangle is the complex's with corners 1, 2 swapped)
+            t[std::size_t(k)] = s.triangles[i][std::size_t(j)];
+          } else {
+            const auto v = vertexOfComplex.find(now[std::size_t(k)]);
+            if (v == vertexOfComplex.end()) throw InternalError("shared walls: a decimated wall's vertex is not its label's");
+            t[std::size_t(k)] = v->second;
+          }
+        }
+        if (b.reversed[i]) std::swap(t[1], t[2]);
+        kept.push_back(t);
+      }
+      // The vertices removed dropped, the others renumbered in order.
+      std::vector<std::uint32_t> renumber(s.vertices.size(), ~0u);
+      for (const auto& t : kept)
+        for (std::uint32_t v : t) renumber[v] = 0;
+      std::uint32_t next = 0;
+      for (std::size_t v = 0; v < renumber.size(); ++v)
+        if (renumber[v] == 0) {
+          renumber[v] = next;
+          s.vertices[next] = s.vertices[v];
+          s.surfels[next] = s.surfels[v];
+          ++next;
+        }
+      s.vertices.resize(next);
+      s.surfels.resize(next);
+      for (auto& t : kept)
+        for (std::uint32_t& v : t) v = renumber[v];
+      s.triangles = std::move(kept);
+      report.trianglesAfter = s.triangles.size();
+      result.decimate = report;
+    }
     result.pinchCopies = split.copyOf.size();
     result.pinchedEdges = split.pinchedEdges;
     result.unsplitEdges = split.unsplitEdges;
@@ -211,13 +292,14 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
                            std::to_string(split.unsplitEdges) +
                            " of them left with four triangles (docs/theory.md §12, pinches)");
     finishScannedLabel(s, mirrored, o);
-    if (smoothing) {
+    if (smoothing || decimating) {
       double after = 0;
       if (o.figures)
         for (const ComponentFigures& c : s.components) after += c.volume;
       else
         for (const ComponentFigures& c : componentFigures(s.vertices, s.triangles)) after += c.volume;
-      result.smooth->volumeAfter = after;
+      if (smoothing) result.smooth->volumeAfter = decimating ? result.decimate->volumeBefore : after;
+      if (decimating) result.decimate->volumeAfter = after;
     }
   }
   return out;

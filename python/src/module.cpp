@@ -417,9 +417,16 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
                             const std::string& boundaries, std::vector<std::array<int, 3>> seeds,
                             const std::string& adjacency, std::array<double, 3> spacing,
                             std::array<double, 3> origin, std::array<std::array<double, 3>, 3> direction,
-                            int threads, bool figures, const std::string& walls, int smoothIterations) {
+                            int threads, bool figures, const std::string& walls, int smoothIterations,
+                            std::optional<double> maxError, std::optional<double> reduction) {
   const VolumeView view = viewOfArray(volume, order, spacing, origin, direction);
   LabelOptions o;
+  if (maxError || reduction) {  // the complex's decimation (docs/theory.md §12, "Decimating the complex"), shared walls only
+    DecimateOptions d;
+    d.maxError = maxError;
+    d.reduction = reduction;
+    o.decimate = d;
+  }
   if (smoothIterations > 0) {  // the complex's smoothing (docs/theory.md §12), shared walls only
     SmoothOptions so;
     so.iterations = smoothIterations;
@@ -457,14 +464,23 @@ py::dict labelSurfacesArray(py::array volume, std::array<int, 3> order, const st
     r->surface = std::move(ls.surface);
     py::dict d = surfaceDict(r);
     d["voxels"] = ls.voxels;
-    if (const auto& smoothed = ls.smooth) {  // as extract()'s "refine", this label's figures
+    if (ls.smooth || ls.decimate) {  // as extract()'s "refine", this label's figures
       py::dict summary;
-      summary["smooth_iterations"] = smoothed->iterations;
-      summary["max_vertex_displacement"] = smoothed->maxDisplacement;
-      summary["steps_back"] = smoothed->stepsBack;
-      summary["unguarded_cubes"] = smoothed->unguardedCubes;
-      summary["volume_before"] = smoothed->volumeBefore;
-      summary["volume_after"] = smoothed->volumeAfter;
+      if (const auto& smoothed = ls.smooth) {
+        summary["smooth_iterations"] = smoothed->iterations;
+        summary["max_vertex_displacement"] = smoothed->maxDisplacement;
+        summary["steps_back"] = smoothed->stepsBack;
+        summary["unguarded_cubes"] = smoothed->unguardedCubes;
+        summary["volume_before"] = smoothed->volumeBefore;
+        summary["volume_after"] = smoothed->volumeAfter;
+      }
+      if (const auto& decimated = ls.decimate) {
+        summary["triangles_before"] = decimated->trianglesBefore;
+        summary["triangles_after"] = decimated->trianglesAfter;
+        summary["target_triangles"] = decimated->targetTriangles;
+        if (!ls.smooth) summary["volume_before"] = decimated->volumeBefore;
+        summary["volume_after"] = decimated->volumeAfter;
+      }
       d["refine"] = summary;
     }
     out[labelObject(ls.label)] = d;

@@ -415,7 +415,8 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
                    background: int = 0, boundaries: str = "all", seeds: Optional[Sequence] = None,
                    adjacency: str = "26-6", spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
                    direction=None, affine=None, threads: int = 0, figures: bool = True,
-                   walls: str = "independent", smooth: int = 0) -> dict:
+                   walls: str = "independent", smooth: int = 0, max_error: Optional[float] = None,
+                   reduce: Optional[float] = None) -> dict:
     """Every label of an integer label image as a closed surface: a dict label -> Surface.
 
     One scan of the cubes triangulates every boundary of every label at once ("largest" and
@@ -434,6 +435,11 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     same point in every label, along its surfel's segment, so each wall stays shared, space stays
     partitioned and each label keeps its voxels and topology (docs/theory.md §12, "Smoothing the
     complex"; each Surface's ``refine`` holds its volume before and after and its largest move).
+    ``max_error`` (physical units) and/or ``reduce`` (the fraction of each wall's triangles to
+    remove; shared walls only) then decimate the complex, each wall once, its junction lines and
+    pinches kept: the walls stay shared triangle for triangle and each label keeps its components
+    and genus, within ``max_error`` of the undecimated walls (docs/theory.md §12, "Decimating the
+    complex"; ``refine`` then also holds the triangles before and after and the target).
     Raises ValueError (surftrack.InvalidInput) / TypeError on bad input.
     """
     array = _as_volume(labels)
@@ -460,6 +466,9 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     if smooth and walls != "shared":
         raise ValueError("smooth= on a label map needs walls='shared': each label smoothed on its own "
                          "would pull the vertices it shares with its neighbours apart")
+    if (max_error is not None or reduce is not None) and walls != "shared":
+        raise ValueError("max_error= and reduce= on a label map need walls='shared': each label decimated "
+                         "on its own would no longer share its walls with its neighbours")
     # Labels reach the engine as Python ints (tolist() turns numpy integers into ints), never
     # through float: uint64 segment ids above 2^53 stay exact.
     kind, values, bounds = "all", [], []
@@ -486,7 +495,9 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     out = _surftrack.label_surfaces_array(array, [2, 1, 0], kind, values, bounds, background,
                                           boundaries, seed_list, adjacency, spacing, origin,
                                           direction.tolist(), int(threads), bool(figures), walls,
-                                          int(smooth))
+                                          int(smooth),
+                                          None if max_error is None else float(max_error),
+                                          None if reduce is None else float(reduce))
     return {label: Surface(**fields) for label, fields in out.items()}
 
 

@@ -88,6 +88,16 @@ struct LabelOptions {
   /// each label keeps its voxels and its topology. With independent walls: refused
   /// (InvalidInput), as each label smoothed on its own would pull the vertices it shares apart.
   std::optional<SmoothOptions> smooth;
+  /// Shared walls only: if set (a maxError, a reduction or both), the decimation of the complex,
+  /// after the smoothing if both are asked (docs/theory.md §12, "Decimating the complex"): each
+  /// wall (the triangles between one pair of labels, the background included) decimated once by
+  /// decimate()'s halfedge collapses and guards, its vertices on junction lines and pinches
+  /// kept, the link condition and the embedding checked over the whole complex; the wall's
+  /// triangles then go to both its labels, so that the walls stay shared triangle for triangle
+  /// and each label keeps its components and genus; each wall within maxError of its undecimated
+  /// self, both ways. The reduction applies to each wall, as far as its locked vertices allow.
+  /// With independent walls: refused (InvalidInput), as smooth.
+  std::optional<DecimateOptions> decimate;
   /// Threads for the scan and for the labels: 0 for all cores. The surfaces are the same for any
   /// number.
   int threads = 0;
@@ -114,6 +124,10 @@ struct LabelSurface {
   /// largest vertex move (physical units); cubes, unguardedCubes, checkedCubes and stepsBack
   /// are the whole complex's, the same in every label. Nothing without smoothing.
   std::optional<SmoothReport> smooth;
+  /// LabelOptions::decimate: this label's triangles and enclosed volume before and after the
+  /// decimation (after the smoothing), its target (1 - reduction) x trianglesBefore (0: no
+  /// reduction). A halfedge collapse moves no vertex: the surviving vertices keep their points.
+  std::optional<DecimateReport> decimate;
 };
 
 /// The surfaces of the selected labels of `view`, by increasing label. Labels are exact over

@@ -1,0 +1,349 @@
+// decimateComplex (ComplexDecimation.h; docs/theory.md §12, "Decimating the complex").
+#include "ComplexDecimation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+#include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
+#include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
+
+#include "Cancellation.h"
+#include "CheckedDecimater.h"
+#include "ComplexLinkGuard.h"
+#include "DistanceGuard.h"
+#include "EmbeddingGuard.h"
+#include "MeshTriangles.h"
+#include "SurfaceMesh.h"
+#include "TopologyGuard.h"
+#include "TriangleGrid.h"
+#include "UnionFind.h"
+
+namespace surftrack::refine {
+namespace {
+
+using Tri = std::array<std::uint32_t, 3>;
+
+/// Each vertex's triangles (compressed rows).
+struct VertexTriangles {
+  std::vector<std::uint32_t> start, list;
+  VertexTriangles(std::size_t vertices, const std::vector<Tri>& triangles) : start(vertices + 1, 0) {
+    for (const Tri& t : triangles)
+      for (std::uint32_t v : t) ++start[v + 1];
+    for (std::size_t v = 0; v < vertices; ++v) start[v + 1] += start[v];
+    list.resize(start.back());
+    std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      for (std::uint32_t v : triangles[t]) list[at[v]++] = t;
+  }
+};
+
+/// The triangles `ts` at vertex v form one closed disc around it: each of their edges at v is
+/// in exactly two of them, once each way, and they are joined through those edges.
+bool closedDisc(std::uint32_t v, const std::vector<std::uint32_t>& ts, const std::vector<Tri>& triangles) {
+  if (ts.size() < 3) return false;
+  // Each triangle's edge out of v (to `next`) and into v (from `prev`), in its orientation.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> around;  // (prev, next)
+  for (std::uint32_t t : ts) {
+    const Tri& x = triangles[t];
+    const int k = int(std::find(x.begin(), x.end(), v) - x.begin());
+    around.push_back({x[std::size_t((k + 2) % 3)], x[std::size_t((k + 1) % 3)]});
+  }
+  // One disc: following next -> the triangle whose prev it is walks all of them in one cycle.
+  std::size_t at = 0, steps = 0;
+  std::vector<char> seen(ts.size(), 0);
+  do {
+    if (seen[at]) return false;
+    seen[at] = 1;
+    ++steps;
+    std::size_t found = ts.size();
+    for (std::size_t j = 0; j < ts.size(); ++j)
+      if (around[j].first == around[at].second) {
+        if (found != ts.size()) return false;  // an edge of more than two
+        found = j;
+      }
+    if (found == ts.size()) return false;  // a border
+    at = found;
+  } while (at != 0);
+  if (steps != ts.size()) return false;
+  // No edge in two triangles the same way (then the walk above could still close).
+  for (std::size_t i = 0; i < ts.size(); ++i)
+    for (std::size_t j = i + 1; j < ts.size(); ++j)
+      if (around[i].second == around[j].second || around[i].first == around[j].first) return false;
+  return true;
+}
+
+}  // namespace
+
+ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::vector<Tri>& triangles,
+                                        const std::vector<std::array<std::uint32_t, 2>>& sides,
+                                        std::vector<char>& removed, const DecimationParameters& p) {
+  requireDecimationParameters(p);
+  if (sides.size() != triangles.size())
+    throw std::invalid_argument("decimateComplex: " + std::to_string(triangles.size()) + " triangles but " +
+                                std::to_string(sides.size()) + " sides");
+  for (const Tri& t : triangles)
+    for (std::uint32_t v : t)
+      if (v >= points.size()) throw std::invalid_argument("decimateComplex: a vertex index is out of range");
+  throwIfCancelled(p.cancel, "decimation");
+  ComplexDecimationReport report;
+  report.trianglesBefore = triangles.size();
+  removed.assign(triangles.size(), 0);
+  const std::size_t n = points.size();
+
+  // 1. Free vertices (one wall, one closed disc for both its regions) and singular ones (some
+  //    region's triangles at it are not one closed disc: a pinch).
+  std::vector<char> freeVertex(n, 0), singular(n, 0);
+  {
+    const VertexTriangles at(n, triangles);
+    std::vector<std::uint32_t> ts;
+    for (std::uint32_t v = 0; v < n; ++v) {
+      const auto b = at.list.begin() + at.start[v], e = at.list.begin() + at.start[v + 1];
+      if (b == e) continue;
+      bool oneWall = true;
+      std::vector<std::uint32_t> regions;
+      for (auto it = b; it != e; ++it) {
+        oneWall = oneWall && sides[*it] == sides[*b];
+        regions.push_back(sides[*it][0]);
+        regions.push_back(sides[*it][1]);
+      }
+      std::sort(regions.begin(), regions.end());
+      regions.erase(std::unique(regions.begin(), regions.end()), regions.end());
+      for (std::uint32_t r : regions) {
+        ts.clear();
+        for (auto it = b; it != e; ++it)
+          if (sides[*it][0] == r || sides[*it][1] == r) ts.push_back(*it);
+        if (!closedDisc(v, ts, triangles)) singular[v] = 1;
+      }
+      freeVertex[v] = oneWall && !singular[v];
+      if (!freeVertex[v]) ++report.lockedVertices;
+    }
+  }
+
+  // 2. The walls, by their ordered pair of regions.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> walls;
+  for (std::uint32_t t = 0; t < triangles.size(); ++t) walls[{sides[t][0], sides[t][1]}].push_back(t);
+  report.walls = walls.size();
+
+  // 3. The whole complex: its incidence (ComplexLinkGuard.h) and a grid of its triangles for
+  //    the obstacles of each wall, both following the walls' decimations.
+  ComplexIncidence incidence;
+  for (const Tri& t : triangles) incidence.add(t);
+  Box3 bounds{{0, 0, 0}, {0, 0, 0}};
+  double edgeLength = 0;
+  for (std::size_t v = 0; v < n; ++v)
+    for (int k = 0; k < 3; ++k) {
+      bounds.lo[k] = v ? std::min(bounds.lo[k], points[v][k]) : points[v][k];
+      bounds.hi[k] = v ? std::max(bounds.hi[k], points[v][k]) : points[v][k];
+    }
+  auto triangleOfIndex = [&](std::uint32_t t) {
+    return Triangle3{points[triangles[t][0]], points[triangles[t][1]], points[triangles[t][2]]};
+  };
+  for (const Tri& t : triangles) edgeLength += norm(sub(points[t[0]], points[t[1]]));
+  edgeLength = triangles.empty() ? 1.0 : edgeLength / double(triangles.size());
+  TriangleGrid grid;
+  grid.reset(bounds, 2 * edgeLength);
+  std::vector<std::uint32_t> version(triangles.size(), 0);
+  for (std::uint32_t t = 0; t < triangles.size(); ++t) grid.insert(t, 0, boxOf(triangleOfIndex(t)));
+
+  // 4. Each wall's mesh and decimater, over the undecimated complex.
+  using Mesh = SurfaceMesh;
+  struct Wall {
+    std::vector<std::uint32_t> ts;
+    std::size_t target = 0, kept = 0, live = 0;  // kept: its triangles outside its mesh
+    Box3 box;
+    std::unique_ptr<Mesh> mesh;
+    OpenMesh::VPropHandleT<std::uint32_t> identity;
+    std::vector<std::uint32_t> triangleOfFace;  // face index -> triangle
+    std::unique_ptr<CheckedDecimaterT<Mesh>> decimater;
+    OpenMesh::Decimater::ModQuadricT<Mesh>::Handle quadric;
+    ModSampledDistanceT<Mesh>::Handle distance;
+    OpenMesh::Decimater::ModNormalFlippingT<Mesh>::Handle flipping;
+    ModTopologyGuardT<Mesh>::Handle topology;
+    ModEmbeddingGuardT<Mesh>::Handle embedding;
+    ModComplexLinkT<Mesh>::Handle link;
+  };
+  std::vector<std::unique_ptr<Wall>> states;  // (the modules' handles cannot be copied)
+  std::vector<std::uint32_t> wallOf(triangles.size(), 0);  // 1 + the index in states of a triangle's wall mesh
+  for (const auto& [pair, ts] : walls) {
+    const std::size_t target =
+        p.targetReduction ? std::size_t(std::llround((1 - *p.targetReduction) * double(ts.size()))) : 0;
+    report.targetTriangles += target;
+    if (std::none_of(ts.begin(), ts.end(), [&](std::uint32_t t) {
+          return freeVertex[triangles[t][0]] || freeVertex[triangles[t][1]] || freeVertex[triangles[t][2]];
+        }))
+      continue;
+    throwIfCancelled(p.cancel, "decimation");
+    // Its triangles but those on an edge of more than two of them or of two the same way (a
+    // pinch of both regions), which stay, as obstacles; each vertex one mesh vertex per fan of
+    // the wall around it (corners joined across the edges of two triangles).
+    std::unordered_map<std::uint64_t, std::vector<std::pair<std::uint32_t, int>>> edges;  // -> (index in ts, corner)
+    for (std::uint32_t i = 0; i < ts.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        edges[ComplexIncidence::edgeKey(triangles[ts[i]][std::size_t(k)], triangles[ts[i]][std::size_t((k + 1) % 3)])]
+            .push_back({i, k});
+    std::vector<char> inMesh(ts.size(), 1);
+    for (const auto& [key, uses] : edges)
+      if (uses.size() > 2 ||
+          (uses.size() == 2 && triangles[ts[uses[0].first]][std::size_t(uses[0].second)] ==
+                                   triangles[ts[uses[1].first]][std::size_t(uses[1].second)]))
+        for (const auto& u : uses) inMesh[u.first] = 0;
+    UnionFind fans(3 * ts.size());
+    for (const auto& [key, uses] : edges) {
+      if (uses.size() != 2 || !inMesh[uses[0].first] || !inMesh[uses[1].first]) continue;
+      const auto [i, a] = uses[0];
+      const auto [j, b] = uses[1];
+      // Edge (x, y) at corners a, a+1 of triangle i and y, x at corners b, b+1 of triangle j.
+      fans.join(3 * i + std::uint32_t(a), 3 * j + std::uint32_t((b + 1) % 3));
+      fans.join(3 * i + std::uint32_t((a + 1) % 3), 3 * j + std::uint32_t(b));
+    }
+    // The mesh; a triangle OpenMesh refuses (a complex vertex it cannot link) stays, with its
+    // vertices, and the mesh is made again without it.
+    states.push_back(std::make_unique<Wall>());
+    Wall& w = *states.back();
+    w.ts = ts;
+    w.target = target;
+    std::vector<std::uint32_t> failedVertices;
+    for (bool failed = true; failed;) {
+      failed = false;
+      w.mesh = std::make_unique<Mesh>();
+      Mesh& mesh = *w.mesh;
+      mesh.add_property(w.identity);
+      w.triangleOfFace.clear();
+      std::unordered_map<std::uint32_t, Mesh::VertexHandle> vertexOfFan;
+      for (std::uint32_t i = 0; i < ts.size() && !failed; ++i) {
+        if (!inMesh[i]) continue;
+        std::array<Mesh::VertexHandle, 3> vh;
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t root = fans.find(3 * i + std::uint32_t(k)), v = triangles[ts[i]][std::size_t(k)];
+          auto [it, added] = vertexOfFan.try_emplace(root);
+          if (added) {
+            it->second = mesh.add_vertex(Mesh::Point(points[v][0], points[v][1], points[v][2]));
+            mesh.property(w.identity, it->second) = v;
+          }
+          vh[std::size_t(k)] = it->second;
+        }
+        const auto f = mesh.add_face(vh[0], vh[1], vh[2]);
+        if (!f.is_valid()) {
+          inMesh[i] = 0;
+          failed = true;
+          for (std::uint32_t v : triangles[ts[i]]) failedVertices.push_back(v);
+          continue;
+        }
+        if (std::size_t(f.idx()) != w.triangleOfFace.size()) throw std::logic_error("decimateComplex: face numbering");
+        w.triangleOfFace.push_back(ts[i]);
+      }
+    }
+    Mesh& mesh = *w.mesh;
+    std::vector<char> meshFree(mesh.n_vertices(), 0), meshSingular(mesh.n_vertices(), 0);
+    for (auto v : mesh.vertices()) {
+      const std::uint32_t c = mesh.property(w.identity, v);
+      meshFree[std::size_t(v.idx())] = freeVertex[c] && !mesh.is_boundary(v) && !mesh.is_isolated(v) &&
+                                       std::find(failedVertices.begin(), failedVertices.end(), c) == failedVertices.end();
+      meshSingular[std::size_t(v.idx())] = singular[c];
+    }
+    if (std::none_of(meshFree.begin(), meshFree.end(), [](char c) { return c != 0; })) {
+      states.pop_back();
+      continue;
+    }
+    w.box = boxOf(triangleOfIndex(ts[0]));
+    for (std::uint32_t t : ts) {
+      const Box3 b = boxOf(triangleOfIndex(t));
+      for (int k = 0; k < 3; ++k) {
+        w.box.lo[k] = std::min(w.box.lo[k], b.lo[k]);
+        w.box.hi[k] = std::max(w.box.hi[k], b.hi[k]);
+      }
+    }
+    w.kept = ts.size() - mesh.n_faces();
+    w.live = mesh.n_faces();
+    mesh.request_vertex_status();
+    mesh.request_edge_status();
+    mesh.request_halfedge_status();
+    mesh.request_face_status();
+    mesh.request_face_normals();
+    mesh.update_face_normals();
+    w.decimater = std::make_unique<CheckedDecimaterT<Mesh>>(mesh);
+    CheckedDecimaterT<Mesh>& decimater = *w.decimater;
+    decimater.add(w.quadric);
+    decimater.add(w.flipping);
+    decimater.add(w.link);  // (first of the guards: the cheapest refusals)
+    decimater.add(w.topology);
+    decimater.add(w.embedding);
+    decimater.module(w.quadric).unset_max_err();
+    if (p.maxError) {
+      decimater.module(w.quadric).set_max_err(*p.maxError * *p.maxError, false);
+      decimater.add(w.distance);
+      decimater.module(w.distance).set_tolerance(*p.maxError);
+    }
+    decimater.module(w.flipping).set_max_normal_deviation(p.maxNormalDeviation);
+    decimater.module(w.link).set_complex(w.identity, std::move(meshFree), std::move(meshSingular), &incidence);
+    decimater.module(w.embedding).set_complex(w.identity);
+    if (!decimater.initialize()) throw std::logic_error("decimateComplex: the decimater refused its modules");
+    for (std::uint32_t t : w.triangleOfFace) wallOf[t] = std::uint32_t(states.size());
+  }
+
+  // 5. The walls decimated in rounds, each wall a part of the way to its target in each round,
+  //    so that no wall takes every chord between junction vertices before the next one starts
+  //    (the link condition over the complex refuses a chord twice).
+  constexpr int kRounds = 4;
+  for (int round = 1; round <= kRounds; ++round)
+    for (std::size_t k = 0; k < states.size(); ++k) {
+      Wall& w = *states[k];
+      Mesh& mesh = *w.mesh;
+      const std::size_t n = w.ts.size();
+      const std::size_t goal = n - (n - std::min(n, w.target)) * std::size_t(round) / kRounds;
+      const std::size_t meshGoal = goal > w.kept ? goal - w.kept : 0;
+      if (w.live <= meshGoal) continue;
+      throwIfCancelled(p.cancel, "decimation");
+      // The obstacles: the complex's triangles near the wall that are not in its mesh, now.
+      std::vector<Triangle3> obstacles;
+      std::vector<Tri> obstacleNames;
+      const double margin = 1e-6 * edgeLength;
+      const Box3 query{{w.box.lo[0] - margin, w.box.lo[1] - margin, w.box.lo[2] - margin},
+                       {w.box.hi[0] + margin, w.box.hi[1] + margin, w.box.hi[2] + margin}};
+      std::vector<std::uint32_t> near;
+      grid.near(query, [&](std::uint32_t t, std::uint32_t tag) {
+        if (tag == version[t] && !removed[t] && wallOf[t] != k + 1) near.push_back(t);
+      });
+      std::sort(near.begin(), near.end());
+      near.erase(std::unique(near.begin(), near.end()), near.end());
+      for (std::uint32_t t : near) {
+        const Triangle3 x = triangleOfIndex(t);
+        if (!boxOf(x).meets(query)) continue;
+        obstacles.push_back(x);
+        obstacleNames.push_back(triangles[t]);
+      }
+      w.decimater->module(w.embedding).set_obstacles(std::move(obstacles), std::move(obstacleNames));
+      auto& quadricModule = w.decimater->module(w.quadric);
+      // (n_faces() counts the faces deleted in earlier rounds too.)
+      const std::size_t deleted = mesh.n_faces() - w.live;
+      w.decimater->decimateToFaces(
+          meshGoal + deleted, [&](const auto& ci) { return quadricModule.collapse_priority(ci); }, p.cancel);
+      // The wall's triangles written back: the survivors' vertices, in their orientation.
+      w.live = 0;
+      for (auto f : mesh.all_faces()) {
+        const std::uint32_t t = w.triangleOfFace[std::size_t(f.idx())];
+        if (removed[t]) continue;
+        if (mesh.status(f).deleted()) {
+          removed[t] = 1;
+          ++version[t];
+          continue;
+        }
+        ++w.live;
+        Tri now;
+        int c = 0;
+        for (auto v : mesh.fv_range(f)) now[std::size_t(c++)] = mesh.property(w.identity, v);
+        if (ComplexIncidence::triangleKey(now) == ComplexIncidence::triangleKey(triangles[t])) continue;
+        triangles[t] = now;
+        grid.insert(t, ++version[t], boxOf(triangleOfIndex(t)));
+      }
+    }
+  report.trianglesAfter = std::size_t(std::count(removed.begin(), removed.end(), 0));
+  return report;
+}
+
+}  // namespace surftrack::refine
