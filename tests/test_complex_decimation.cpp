@@ -33,32 +33,18 @@
 #include "Labels.h"
 #include "MeshChecks.h"
 #include "Refine.h"
+#include "WallPoints.h"
 
 namespace surftrack {
 namespace {
 
 using testing::caseChecked;
 using P3 = std::array<double, 3>;
-using Bits = std::array<std::uint64_t, 3>;
-
-Bits bitsOf(const P3& p) {
-  Bits b;
-  for (int i = 0; i < 3; ++i) std::memcpy(&b[std::size_t(i)], &p[std::size_t(i)], sizeof(double));
-  return b;
-}
-using DirectedTriangle = std::array<Bits, 3>;  // rotated so that the least point comes first
-DirectedTriangle directed(Bits a, Bits b, Bits c) {
-  DirectedTriangle t{a, b, c};
-  std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
-  return t;
-}
-
-/// The grid edge of a surfel, whichever way it is oriented: its low voxel and axis.
-std::array<int, 4> gridEdge(const Surfel& s) {
-  const Voxel c = s.inside(), d = s.outside();
-  const Voxel lo{std::min(c.x, d.x), std::min(c.y, d.y), std::min(c.z, d.z)};
-  return {lo.x, lo.y, lo.z, c.x != d.x ? 0 : c.y != d.y ? 1 : 2};
-}
+using testing::Bits;
+using testing::bitsOf;
+using testing::directed;
+using testing::DirectedTriangle;
+using testing::gridEdge;
 
 /// The whole complex as a soup: the points by their bits, each wall triangle once (as the first
 /// label that has it gives it), with its wall: the indices of the labels that have it (one for

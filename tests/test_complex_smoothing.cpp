@@ -33,6 +33,7 @@
 #include "Labels.h"
 #include "MeshChecks.h"
 #include "Refine.h"
+#include "WallPoints.h"
 
 namespace surftrack {
 namespace {
@@ -40,26 +41,11 @@ namespace {
 using testing::caseChecked;
 using P3 = std::array<double, 3>;
 
-/// A point's exact bits, so that "the same point" means bit-identical coordinates.
-using Bits = std::array<std::uint64_t, 3>;
-Bits bitsOf(const P3& p) {
-  Bits b;
-  for (int i = 0; i < 3; ++i) std::memcpy(&b[std::size_t(i)], &p[std::size_t(i)], sizeof(double));
-  return b;
-}
-using DirectedTriangle = std::array<Bits, 3>;  // rotated so that the least point comes first
-DirectedTriangle directed(Bits a, Bits b, Bits c) {
-  DirectedTriangle t{a, b, c};
-  std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
-  return t;
-}
-
-/// The grid edge of a surfel, whichever way it is oriented: its low voxel and axis.
-std::array<int, 4> gridEdge(const Surfel& s) {
-  const Voxel c = s.inside(), d = s.outside();
-  const Voxel lo{std::min(c.x, d.x), std::min(c.y, d.y), std::min(c.z, d.z)};
-  return {lo.x, lo.y, lo.z, c.x != d.x ? 0 : c.y != d.y ? 1 : 2};
-}
+using testing::Bits;
+using testing::bitsOf;
+using testing::directed;
+using testing::DirectedTriangle;
+using testing::gridEdge;
 
 struct Counts {
   std::size_t twins = 0, borders = 0;
