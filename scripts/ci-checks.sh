@@ -46,9 +46,12 @@ sanitize_build() {
   # -O1: instrumented code at -O3 compiles about 4x slower (one test file: 765 s against 177 s
   # at -O1) for tests that run about 2x faster; stacks name functions (frame pointers kept), not
   # lines. No benchmarks (nor the CGAL tool they use).
-  # Without the Python module: the suite's last cut for CI's 30 minutes (about 100 CPU-s of
-  # compile and 100 of tests); its binding code is exercised by python_tests in the main build.
+  # The engine and its tests only: without the Python module (about 100 CPU-s of compile and
+  # 100 of tests) nor the command-line tool and the ITK readers (about 450 CPU-s of compile),
+  # for CI's 30 minutes. Those are tested by the main build's suite, and the volume-header and
+  # chunked-store readers under both sanitizers by the fuzzing beside this build (fuzz/).
   cmake -S . -B build-sanitize -DSURFTRACK_SANITIZE=ON -DSURFTRACK_BUILD_BENCH=OFF -DSURFTRACK_BUILD_PYTHON=OFF \
+        -DSURFTRACK_BUILD_CLI=OFF \
         -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" >/dev/null
   cmake --build build-sanitize -j2 >build-sanitize.log 2>&1 || { tail -60 build-sanitize.log; exit 1; }
   child_cpu
