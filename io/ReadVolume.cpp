@@ -225,7 +225,7 @@ itk::ImageIORegion wholeRegion(const itk::ImageIOBase* imageIO) {
 /// chooses T so): its output information, and the voxels the ImageIO writes straight into the
 /// image's buffer, as ImageFileReader::GenerateData does in that case. One reader type for all
 /// the pixel types instead of ten keeps ITK's pixel conversions, which surftrack never uses, out
-/// of the build (they took most of this file's compile time).
+/// of the build (about 40 % of this file's compile time).
 template <class T>
 ImagePointer<T> readFileAs(itk::ImageIOBase* imageIO, const std::string& path) {
   auto reader = itk::ImageFileReader<InformationImage>::New();

@@ -16,6 +16,18 @@
 
 namespace surftrack::refine {
 
+/// The status flags OpenMesh's collapses need and the face normals the modules read, requested
+/// and filled before a CheckedDecimaterT is built on `mesh`.
+template <class MeshT>
+void prepareForDecimation(MeshT& mesh) {
+  mesh.request_vertex_status();
+  mesh.request_edge_status();
+  mesh.request_halfedge_status();
+  mesh.request_face_status();
+  mesh.request_face_normals();
+  mesh.update_face_normals();
+}
+
 template <class MeshT>
 class CheckedDecimaterT : public OpenMesh::Decimater::BaseDecimaterT<MeshT> {
  public:

@@ -260,12 +260,7 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
     }
     w.kept = ts.size() - mesh.n_faces();
     w.live = mesh.n_faces();
-    mesh.request_vertex_status();
-    mesh.request_edge_status();
-    mesh.request_halfedge_status();
-    mesh.request_face_status();
-    mesh.request_face_normals();
-    mesh.update_face_normals();
+    prepareForDecimation(mesh);
     w.decimater = std::make_unique<CheckedDecimaterT<Mesh>>(mesh);
     CheckedDecimaterT<Mesh>& decimater = *w.decimater;
     decimater.add(w.quadric);

@@ -33,12 +33,7 @@ DecimationReport decimateSafely(SurfaceMesh& mesh, const DecimationParameters& p
 
   DecimationReport report;
   report.trianglesBefore = mesh.n_faces();
-  mesh.request_vertex_status();
-  mesh.request_edge_status();
-  mesh.request_halfedge_status();
-  mesh.request_face_status();
-  mesh.request_face_normals();
-  mesh.update_face_normals();
+  prepareForDecimation(mesh);
 
   CheckedDecimaterT<SurfaceMesh> decimater(mesh);
   OpenMesh::Decimater::ModQuadricT<SurfaceMesh>::Handle quadric;
