@@ -18,7 +18,8 @@ meshing, in one run (docs/performance.md, "Label maps as one conforming complex"
      Oosterom and Strackee). A point is right when it is inside exactly one label, or at most
      one where a corner of its cell is background (the background has no mesh). Overlaps (in
      two or more) and gaps (in none where one is required) are counted apart. For AAL only the
-     cells around the few labels of the picture (5) are sampled, for time;
+     cells among the labels of the picture and the background are sampled, and a third of
+     the points, for time;
    - defects: per label, edges of more than two triangles, boundary edges (one triangle) and
      vertices at the same coordinates as another vertex of the label; the count of labels with
      each and the sum.
@@ -49,12 +50,17 @@ meshing, in one run (docs/performance.md, "Label maps as one conforming complex"
    seconds (time.perf_counter) and CPU seconds (time.process_time, all threads; the CLI's from
    getrusage of the child). No time is printed unless the complex's walls are all shared (every
    triangle that needs a twin has one) and the CLI's triangle counts are the binding's.
-5. A picture: 5 AAL regions that touch each other, cut by a plane through their centre so the
-   walls between them show, before (the midpoint complex) and after (smooth 10, reduce 0.9),
-   rendered with matplotlib (Agg), to --picture.
+5. A picture: AAL regions that touch each other (--picture-labels, default the left caudate,
+   putamen, pallidum and thalamus; else 5 labels: the pair with the largest contact, then the
+   label with the most contact with the group, and so on), cut by a plane through their centre
+   across their thinnest axis so the walls between them show, before (the midpoint complex) and
+   after (smooth 10, reduce 0.9), rendered with matplotlib (Agg), to --picture. The atlas is
+   cropped to the group's box with a 12-voxel margin for it (the walls near the group are the
+   whole atlas's).
 
---quick: small sizes (a smoke run: Voronoi 32³ of 30 cells, random 12³, spheres of radius 5 and
-10, a 48³ crop of AAL). --skip-aal leaves the atlas out. The script checks what it measures: the
+--quick: small sizes (a smoke run: Voronoi 32³ of 30 cells, random 12³, 600 points, spheres of
+radius 5 and 10, a tube of 20 voxels, a 48³ crop of AAL around the picture's labels for tables 1, 2
+and 4). --skip-aal leaves the atlas out. The script checks what it measures: the
 complex must have every twin and every point right, else it stops with an error.
 
 Needs Debian's /usr/bin/python3 with numpy, python3-vtk9, matplotlib; scipy (Voronoi) and nibabel
@@ -79,6 +85,7 @@ import surftrack
 
 AAL = "/usr/share/mricron/templates/aal.nii.gz"
 WINDING_TOLERANCE = 1e-6
+TAB10 = ("blue", "orange", "green", "red", "purple", "brown", "pink", "grey", "olive", "cyan")  # matplotlib's
 
 
 # ----------------------------------------------------------------------------------------- inputs
@@ -181,6 +188,13 @@ def needs_twin(surface, labels, background):
     value[inside] = labels[tuple(s[inside].T)]
     labelled = np.all(inside & (value != background), axis=1)
     return labelled[surface.faces.astype(np.int64)].any(axis=1)
+
+
+class Surfaceless:
+    """vertices and faces, as defects() reads them from a Surface."""
+
+    def __init__(self, vertices, faces):
+        self.vertices, self.faces = vertices, faces
 
 
 def defects(surface):
@@ -441,6 +455,10 @@ def accuracy_rows(quick, threads):
         for n in (10, 50):
             results.append((f"VTK windowed sinc {n}",) + vtk_sinc(midpoint.vertices, midpoint.faces, n))
         for method, v, f in results:
+            closed = Surfaceless(v, f)
+            if len(f) != len(midpoint.faces) or defects(closed)[:2] != (0, 0):
+                sys.exit(f"bench_complex: {method} on the {name} is not the midpoint mesh's closed 2-manifold "
+                         f"connectivity ({len(f)} triangles, {defects(closed)[:2]} edges of 3+ / 1 triangle)")
             a, vol, normals, centroids = area_volume_normals(v, f)
             keep = measured(centroids)
             cosine = np.clip(np.einsum("fi,fi->f", normals[keep], normal(centroids[keep])), -1, 1)
@@ -545,46 +563,78 @@ def touching_group(labels, size=5):
     return sorted(group)
 
 
-def render(panels, titles, path):
+def group_box(labels, group, margin):
+    """The slices of the box around the group's voxels, `margin` voxels wider (clamped)."""
+    where = np.argwhere(np.isin(labels, group))
+    lo = np.maximum(where.min(axis=0) - margin, 0)
+    hi = np.minimum(where.max(axis=0) + 1 + margin, labels.shape)
+    return tuple(slice(a, b) for a, b in zip(lo, hi))
+
+
+def render(panels, titles, path, caption=""):
+    """The panels side by side (matplotlib, Agg): each label's triangles on the near side of the
+    plane through the group's centre across its longest axis, lit, one colour per label, drawn as
+    one collection so that the depth order is over all the labels."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-    colours = plt.get_cmap("tab10").colors
-    everything = np.concatenate([v for panel in panels for v, f, _ in panel])
-    centre = everything.mean(axis=0)
-    fig = plt.figure(figsize=(11, 5.5), dpi=90)
+    colours = np.array(plt.get_cmap("tab10").colors)
+    everything = np.concatenate([v for panel in panels for v, f in panel])
+    centre = (everything.max(axis=0) + everything.min(axis=0)) / 2
+    extent = everything.max(axis=0) - everything.min(axis=0)
+    cut = int(np.argmin(extent))  # the cut shows the walls across the group's thinnest axis
+    view = np.zeros(3)
+    view[cut] = 1
+    fig = plt.figure(figsize=(11, 5.6), dpi=90)
     for n, (panel, title) in enumerate(zip(panels, titles)):
         ax = fig.add_subplot(1, len(panels), n + 1, projection="3d")
-        light = np.array([0.4, -0.5, 0.77])
-        for index, (v, f, label) in enumerate(panel):
+        tris, shades = [], []
+        for index, (v, f) in enumerate(panel):
             tri = v[f.astype(np.int64)]
-            keep = tri.mean(axis=1)[:, 2] <= centre[2]  # cut by the plane through the group's centre
-            tri = tri[keep]
+            tri = tri[tri.mean(axis=1)[:, cut] <= centre[cut]]
             normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
             normal /= np.linalg.norm(normal, axis=1)[:, None]
-            shade = 0.35 + 0.65 * np.abs(normal @ light)
-            colour = np.array(colours[index % len(colours)])[None, :] * shade[:, None]
-            ax.add_collection3d(Poly3DCollection(tri, facecolors=np.clip(colour, 0, 1), edgecolors=(0, 0, 0, 0.25),
-                                                 linewidths=0.08))
-        span = (everything.max(axis=0) - everything.min(axis=0)).max() / 2
+            light = 0.35 + 0.65 * np.abs(normal @ (0.8 * view + 0.35))
+            tris.append(tri)
+            shades.append(colours[index % len(colours)][None, :] * light[:, None])
+        ax.add_collection3d(Poly3DCollection(np.concatenate(tris), facecolors=np.clip(np.concatenate(shades), 0, 1),
+                                             edgecolors=(0, 0, 0, 0.3), linewidths=0.06))
+        span = extent.max() / 2
         for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
             setter(c - span, c + span)
-        ax.view_init(elev=60, azim=-60)
+        # Look at the cut face from the kept side, slightly from above.
+        ax.view_init(*{0: (20, 20), 1: (20, 70), 2: (70, -60)}[cut])
+        try:
+            ax.set_box_aspect(None, zoom=1.5)
+        except TypeError:  # matplotlib before 3.6: no zoom
+            pass
         ax.set_axis_off()
-        ax.set_title(title)
-    fig.tight_layout()
+        fig.text((n + 0.5) / len(panels), 0.95, title, ha="center", fontsize=12)
+    fig.text(0.5, 0.02, caption, ha="center")
+    fig.subplots_adjust(left=0, right=1, bottom=0.05, top=0.92, wspace=0)
     fig.savefig(path)
     plt.close(fig)
+    try:  # 256 colours: a third of the bytes, for a picture kept in the repository
+        from PIL import Image
+        Image.open(path).convert("RGB").quantize(256).save(path, optimize=True)
+    except ImportError:
+        pass
 
 
 def picture(labels, group, threads, path):
-    before = meshes(labels, "shared", threads, only=group)
-    after = meshes(labels, "shared", threads, only=group, smooth=10, reduce=0.9)
-    render([[(before[k].vertices, before[k].faces, k) for k in group],
-            [(after[k].vertices, after[k].faces, k) for k in group]],
+    """The group's labels in the atlas cropped to their box with a 12-voxel margin (the walls near
+    the group are those of the whole atlas; the smoothing and the decimation near the crop's border
+    differ, far from the group), before and after."""
+    box = labels[group_box(labels, group, 12)]
+    box = np.ascontiguousarray(box)
+    before = meshes(box, "shared", threads, only=group)
+    after = meshes(box, "shared", threads, only=group, smooth=10, reduce=0.9)
+    render([[(before[k].vertices, before[k].faces) for k in group], [(after[k].vertices, after[k].faces) for k in group]],
            [f"midpoint complex ({sum(len(before[k].faces) for k in group):,} triangles)",
-            f"smooth 10, reduce 0.9 ({sum(len(after[k].faces) for k in group):,} triangles)"], path)
+            f"smooth 10, reduce 0.9 ({sum(len(after[k].faces) for k in group):,} triangles)"], path,
+           "labels " + ", ".join(f"{k} ({c})" for k, c in zip(group, itertools.cycle(TAB10)))
+           + ", cut by a plane through their centre")
     return os.path.getsize(path)
 
 
@@ -609,6 +659,9 @@ def main():
     ap.add_argument("--cli", default=os.path.join("build", "cli", "surftrack"), help="the surftrack CLI")
     ap.add_argument("--picture", default=os.path.join("docs", "complex-before-after.png"),
                     help="the PNG of the AAL regions before and after (default docs/complex-before-after.png)")
+    ap.add_argument("--picture-labels", default="71,73,75,77",
+                    help="the atlas labels of the picture (default 71,73,75,77: AAL's left caudate, putamen, "
+                         "pallidum, thalamus; when one is missing, 5 touching labels are chosen)")
     ap.add_argument("--points", type=int, default=3000, help="random points per input (default 3000)")
     a = ap.parse_args()
     started = time.perf_counter()
@@ -623,10 +676,16 @@ def main():
             print(f"(no {a.aal}: the AAL atlas is left out)\n")
         else:
             aal = read_nifti(a.aal)
-            if a.quick:  # a 48³ crop through the middle of the brain
-                c = [n // 2 - 24 for n in aal.shape]
-                aal = np.ascontiguousarray(aal[c[0]:c[0] + 48, c[1]:c[1] + 48, c[2]:c[2] + 48])
-    group = touching_group(aal) if aal is not None else []
+    group = []
+    if aal is not None:
+        group = [int(v) for v in a.picture_labels.split(",")] if a.picture_labels else []
+        if not group or not np.isin(group, aal).all():
+            group = touching_group(aal)
+    whole = aal
+    if aal is not None and a.quick:  # a 48³ crop around the picture's labels
+        centre = np.argwhere(np.isin(aal, group)).mean(axis=0).astype(int)
+        lo = [min(max(c - 24, 0), n - 48) for c, n in zip(centre, aal.shape)]
+        aal = np.ascontiguousarray(aal[lo[0]:lo[0] + 48, lo[1]:lo[1] + 48, lo[2]:lo[2] + 48])
 
     # 1. The stress table.
     inputs = [("Voronoi 32³, 30 cells" if a.quick else "Voronoi 96³, 300 cells",
@@ -639,7 +698,8 @@ def main():
         inputs.append((f"AAL{' (48³ crop)' if a.quick else ''}, points near labels {group}", aal, group))
     rows = []
     for seed, (name, labels, subset) in enumerate(inputs):
-        p = sample_points(labels, 0, points, 100 + seed, subset)
+        # AAL's labels are large (about 12,000 triangles each): a third of the points, for time.
+        p = sample_points(labels, 0, points if subset is None else points // 3, 100 + seed, subset)
         for walls in ("independent", "shared"):
             rows.append(stress_row(name, labels, walls, 0, a.threads, p))
     out["stress"] = rows
@@ -709,7 +769,7 @@ def main():
         print(f"\nThe complex: {py['triangles_before']:,} triangles before decimation, target {py['target']:,}; "
               "every wall shared (checked before timing was printed).\n")
         if group:
-            size = picture(aal, group, a.threads, a.picture)
+            size = picture(whole, group, a.threads, a.picture)
             out["picture"] = {"path": a.picture, "labels": group, "bytes": size}
             print(f"## 5. Picture: labels {group} -> {a.picture} ({size / 1024:.0f} KB"
                   f"{'; larger than 300 KB: do not commit it' if size > 300 * 1024 else ''})\n")
