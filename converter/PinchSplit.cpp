@@ -18,29 +18,18 @@ P cross(const P& a, const P& b) {
 }
 double dot(const P& a, const P& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-}  // namespace
+struct Side {
+  std::uint32_t lo, hi, triangle;
+  std::uint8_t corner;  // the side runs from corner to corner + 1 of its triangle
+};
 
-PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
-                        const std::vector<std::array<std::uint32_t, 3>>& triangles) {
-  // Every triangle side as (low vertex, high vertex, triangle, corner of its first vertex),
-  // sorted so that the sides of one edge are together.
-  struct Side {
-    std::uint32_t lo, hi, triangle;
-    std::uint8_t corner;  // the side runs from corner to corner + 1 of its triangle
-  };
-  std::vector<Side> sides;
-  sides.reserve(3 * triangles.size());
-  for (std::uint32_t t = 0; t < triangles.size(); ++t)
-    for (std::uint8_t j = 0; j < 3; ++j) {
-      const std::uint32_t a = triangles[t][j], b = triangles[t][(j + 1) % 3];
-      sides.push_back({std::min(a, b), std::max(a, b), t, j});
-    }
-  std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
-    return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.triangle < y.triangle;
-  });
-  // Corners 3t + j; two corners joined are one sheet at their vertex.
-  UnionFind sheets(3 * triangles.size());
-  PinchSplit out;
+/// The vertices' sheets under one pairing of each edge's triangles, and the copies they give:
+/// `joined` (sorted lo << 32 | hi) lists the pinched edges whose triangles are paired across the
+/// complement's sectors instead of the region's (the region taken as joined along the edge).
+void pairAndCopy(const std::vector<std::array<double, 3>>& points, const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                 const std::vector<Side>& sides, const std::vector<std::uint64_t>& joined, PinchSplit& out) {
+  UnionFind sheets(3 * triangles.size());  // corners 3t + j; two joined are one sheet at their vertex
+  out.pinchedEdges = 0;
   auto runsLowToHigh = [&](const Side& s) { return triangles[s.triangle][s.corner] == s.lo; };
   auto pair = [&](const Side& x, const Side& y) {  // the two triangles bound one sector
     const std::uint32_t tx = x.triangle, ty = y.triangle;
@@ -77,12 +66,14 @@ PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
       }
       std::sort(around.begin(), around.end());
       // A triangle whose side runs hi -> lo has its outward normal turned clockwise: the region
-      // lies counter-clockwise of it, up to the next triangle, which must run lo -> hi.
+      // lies counter-clockwise of it, up to the next triangle, which must run lo -> hi. Joined,
+      // the complement's sector counter-clockwise of each lo -> hi triangle is bounded instead.
+      const bool join = std::binary_search(joined.begin(), joined.end(), std::uint64_t(sides[b].lo) << 32 | sides[b].hi);
       for (std::size_t k = 0; k < n; ++k) {
         const Side& x = sides[around[k].second];
-        if (runsLowToHigh(x)) continue;
+        if (runsLowToHigh(x) != join) continue;
         const Side& y = sides[around[(k + 1) % n].second];
-        if (!runsLowToHigh(y)) throw std::logic_error("splitPinches: the triangles around an edge do not alternate");
+        if (runsLowToHigh(y) == join) throw std::logic_error("splitPinches: the triangles around an edge do not alternate");
         pair(x, y);
       }
     }
@@ -90,6 +81,7 @@ PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
   }
   // Each vertex's sheets: the first keeps the vertex, the others get copies.
   out.triangles = triangles;
+  out.copyOf.clear();
   std::vector<std::uint32_t> copy(3 * triangles.size(), ~0u);  // root corner -> vertex
   std::vector<char> taken(points.size(), 0);
   for (std::uint32_t t = 0; t < triangles.size(); ++t)
@@ -106,18 +98,59 @@ PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
       }
       out.triangles[t][j] = copy[root];
     }
-  std::vector<std::uint64_t> edges;
+}
+
+/// The edges of more than two triangles of `out`, named by their original vertices (sorted
+/// lo << 32 | hi, each once); `count` gets how many edges of `out` they are.
+std::vector<std::uint64_t> crowdedEdges(std::size_t vertexCount, const PinchSplit& out, std::size_t& count) {
+  auto original = [&](std::uint32_t v) -> std::uint64_t { return v < vertexCount ? v : out.copyOf[v - vertexCount]; };
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> edges;  // (split edge, original edge)
   for (const auto& t : out.triangles)
     for (int j = 0; j < 3; ++j) {
       const std::uint64_t a = t[std::size_t(j)], b = t[std::size_t((j + 1) % 3)];
-      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+      const std::uint64_t oa = original(t[std::size_t(j)]), ob = original(t[std::size_t((j + 1) % 3)]);
+      edges.push_back({std::min(a, b) << 32 | std::max(a, b), std::min(oa, ob) << 32 | std::max(oa, ob)});
     }
   std::sort(edges.begin(), edges.end());
+  std::vector<std::uint64_t> crowded;
+  count = 0;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t e = i;
-    while (e < edges.size() && edges[e] == edges[i]) ++e;
-    out.unsplitEdges += e - i > 2;
+    while (e < edges.size() && edges[e].first == edges[i].first) ++e;
+    if (e - i > 2) crowded.push_back(edges[i].second), ++count;
     i = e;
+  }
+  std::sort(crowded.begin(), crowded.end());
+  crowded.erase(std::unique(crowded.begin(), crowded.end()), crowded.end());
+  return crowded;
+}
+
+}  // namespace
+
+PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
+                        const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  // Every triangle side as (low vertex, high vertex, triangle, corner of its first vertex),
+  // sorted so that the sides of one edge are together.
+  std::vector<Side> sides;
+  sides.reserve(3 * triangles.size());
+  for (std::uint32_t t = 0; t < triangles.size(); ++t)
+    for (std::uint8_t j = 0; j < 3; ++j) {
+      const std::uint32_t a = triangles[t][j], b = triangles[t][(j + 1) % 3];
+      sides.push_back({std::min(a, b), std::max(a, b), t, j});
+    }
+  std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
+    return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.triangle < y.triangle;
+  });
+  PinchSplit out;
+  pairAndCopy(points, triangles, sides, {}, out);
+  std::size_t crowded = 0;
+  std::vector<std::uint64_t> joined = crowdedEdges(points.size(), out, crowded);
+  if (!joined.empty()) {
+    // The region wraps round and touches itself along these edges: taken as joined there, the
+    // sheets at each end part, and copies of both ends separate them (PinchSplit.h).
+    pairAndCopy(points, triangles, sides, joined, out);
+    out.joinedEdges = joined.size();
+    crowdedEdges(points.size(), out, out.unsplitEdges);
   }
   return out;
 }

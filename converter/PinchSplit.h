@@ -7,7 +7,11 @@
 // but the first gets a new copy of the vertex, at the same point. Nothing moves; the wall
 // triangles stay shared (the same points, the same surfels). A pinched edge whose sheets are
 // joined around both its ends (the region wraps round and touches itself along the edge) is not
-// separated by any copy of a vertex: it stays, counted (unsplitEdges).
+// separated by any copy of a vertex; there the region is taken as joined along the edge instead
+// (its triangles paired across the complement's sectors), which parts the sheets at both ends,
+// and the copies of both ends separate the edge's triangles into two edges at the same points
+// (joinedEdges; docs/theory.md §12, "The exception"). An edge still of more than two triangles
+// after that stays, counted (unsplitEdges).
 #pragma once
 
 #include <array>
@@ -23,7 +27,9 @@ struct PinchSplit {
   std::vector<std::uint32_t> copyOf;
   std::size_t pinchedEdges = 0;  ///< edges of more than 2 triangles
   /// Pinched edges whose sheets are joined around both of their ends, so that no vertex copy
-  /// separates them: still edges of more than 2 triangles after the split.
+  /// separates them with the region's pairing: taken as joined along the edge instead.
+  std::size_t joinedEdges = 0;
+  /// Edges still of more than 2 triangles after the split (joined ones included).
   std::size_t unsplitEdges = 0;
 };
 

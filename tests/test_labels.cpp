@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <map>
 #include <random>
@@ -738,6 +739,82 @@ TEST_P(Atlas, EveryLabelIsAClosedManifoldMeetingItsNeighboursExactly) {
           }
         } else {
           FAIL() << path << " holds " << toString(scalarTypeOf<T>()) << " voxels, not labels";
+        }
+      },
+      any);
+}
+
+// Shared walls (docs/theory.md §12) on the atlas: each triangle of a label has its reversed twin
+// in exactly one other label, or lies on the background's wall (each vertex's surfel then has a
+// background voxel); each label a closed oriented 2-manifold (its pinches split or joined, no
+// edge left of four triangles) whose vertices at one point are exactly its pinch copies. Points
+// as doubled voxel indices (c + d of the vertex's surfel): exact.
+TEST_P(Atlas, SharedWallsAreTwinsAndEveryLabelIsAManifold) {
+  const std::string path = std::string(kAtlasDirectory) + "/" + GetParam();
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
+  const io::AnyVolume any = io::readVolume(path);
+  std::visit(
+      [&](const auto& image) {
+        using T = typename std::decay_t<decltype(image)>::value_type;
+        if constexpr (std::is_integral_v<T>) {
+          const VolumeView view = VolumeView::of(image.data().data(), image.dims(), image.geometry());
+          const Dims dims = image.dims();
+          auto labelAt = [&](const Voxel& v) -> long long {  // outside the domain: the background
+            if (v.x < 0 || v.y < 0 || v.z < 0 || v.x >= dims.nx || v.y >= dims.ny || v.z >= dims.nz) return 0;
+            return (long long)image.data()[std::size_t(v.x + std::int64_t(dims.nx) * (v.y + std::int64_t(dims.ny) * v.z))];
+          };
+          LabelOptions options;
+          options.walls = LabelWalls::Shared;
+          const auto surfaces = extractLabels(view, options);
+          using Key = std::array<int, 3>;
+          using Tri = std::array<Key, 3>;
+          auto keyOf = [](const Surfel& s) {
+            const Voxel c = s.inside(), d = s.outside();
+            return Key{c.x + d.x, c.y + d.y, c.z + d.z};
+          };
+          auto directed = [](Tri t) {
+            std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+            return t;
+          };
+          std::vector<std::pair<Tri, std::size_t>> owners;  // (directed triangle, label index)
+          std::size_t copies = 0, joined = 0, pinched = 0;
+          for (std::size_t l = 0; l < surfaces.size(); ++l) {
+            const LabelSurface& ls = surfaces[l];
+            const Surface& s = ls.surface;
+            SCOPED_TRACE("label " + ls.label.text());
+            EXPECT_EQ(ls.unsplitEdges, 0u);
+            const checks::Topology topology = checks::topologyOf(s.vertices.size(), s.triangles);
+            EXPECT_TRUE(topology.manifoldVertices) << topology.problem;
+            EXPECT_EQ(topology.euler, s.euler);
+            std::vector<Key> keys;
+            for (const Surfel& f : s.surfels) keys.push_back(keyOf(f));
+            for (const auto& t : s.triangles) owners.push_back({directed({keys[t[0]], keys[t[1]], keys[t[2]]}), l});
+            std::sort(keys.begin(), keys.end());
+            EXPECT_EQ(s.vertices.size() - std::size_t(std::unique(keys.begin(), keys.end()) - keys.begin()), ls.pinchCopies);
+            copies += ls.pinchCopies, joined += ls.joinedEdges, pinched += ls.pinchedEdges;
+          }
+          std::size_t twins = 0, onBackground = 0;
+          std::sort(owners.begin(), owners.end());
+          for (std::size_t i = 0; i < owners.size(); ++i) {
+            const auto& [t, label] = owners[i];
+            ASSERT_TRUE(i == 0 || owners[i - 1].first != t) << "a triangle twice the same way";
+            const Tri reverse = directed({t[0], t[2], t[1]});
+            const auto back = std::lower_bound(owners.begin(), owners.end(), std::pair<Tri, std::size_t>{reverse, 0});
+            if (back != owners.end() && back->first == reverse) {
+              ASSERT_NE(back->second, label) << "a triangle and its reverse in one label";
+              ++twins;
+              continue;
+            }
+            ++onBackground;
+            for (const Key& k : t) {  // the vertex's surfel: the voxels k / 2 and (k + 1) / 2
+              const Voxel c{k[0] >> 1, k[1] >> 1, k[2] >> 1}, d{(k[0] + 1) >> 1, (k[1] + 1) >> 1, (k[2] + 1) >> 1};
+              ASSERT_TRUE(labelAt(c) == 0 || labelAt(d) == 0) << "a triangle without its twin off the background";
+            }
+          }
+          EXPECT_GT(twins, 0u);
+          std::cout << "[ study ] " << GetParam() << ": " << surfaces.size() << " labels, " << twins
+                    << " wall triangles with their twin, " << onBackground << " on the background; " << pinched
+                    << " pinched edges (" << joined << " taken as joined), " << copies << " vertex copies\n";
         }
       },
       any);

@@ -366,7 +366,7 @@ long closedCubesEuler(const std::vector<Voxel>& voxels) {
 
 TEST(SharedWalls, ThousandRandomLabelImages) {
   std::mt19937_64 rng(2026);
-  std::size_t eulerChecked = 0, unsplit = 0, unsplitLabels = 0, images = 0, labelsSeen = 0, pinchedLabels = 0, copies = 0, pinchedEdges = 0, points = 0, walls = 0;
+  std::size_t eulerChecked = 0, unsplit = 0, unsplitLabels = 0, joined = 0, joinedLabels = 0, images = 0, labelsSeen = 0, pinchedLabels = 0, copies = 0, pinchedEdges = 0, points = 0, walls = 0;
   for (int image = 0; image < 1000; ++image) {
     std::uniform_int_distribution<int> side(2, 5);
     const Dims dims{side(rng), side(rng), side(rng)};
@@ -477,6 +477,9 @@ TEST(SharedWalls, ThousandRandomLabelImages) {
       }
       unsplit += l.unsplitEdges;
       if (l.unsplitEdges) ++unsplitLabels;
+      ASSERT_LE(l.joinedEdges, l.pinchedEdges);
+      joined += l.joinedEdges;
+      if (l.joinedEdges) ++joinedLabels;
       if (l.unsplitEdges == 0) {
         ASSERT_EQ(topology.euler, s.euler);  // (figures count an edge per two triangles)
       }
@@ -564,7 +567,8 @@ TEST(SharedWalls, ThousandRandomLabelImages) {
   EXPECT_GE(eulerChecked, testing::subsetMinimum(3000));
   std::cout << "[ study ] " << images << " random images, " << labelsSeen << " labels, " << walls
             << " directed wall triangles, " << points << " points; " << pinchedLabels << " labels with pinches, "
-            << copies << " vertex copies, " << pinchedEdges << " pinched edges; " << unsplitLabels
+            << copies << " vertex copies, " << pinchedEdges << " pinched edges; " << joinedLabels << " labels with "
+            << joined << " edges taken as joined; " << unsplitLabels
             << " labels with " << unsplit << " edges no copy separates; Euler characteristic checked on "
             << eulerChecked << " labels without pinches\n";
 }

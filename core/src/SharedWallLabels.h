@@ -285,12 +285,13 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     }
     result.pinchCopies = split.copyOf.size();
     result.pinchedEdges = split.pinchedEdges;
+    result.joinedEdges = split.joinedEdges;
     result.unsplitEdges = split.unsplitEdges;
     if (!split.copyOf.empty() || split.pinchedEdges)
       s.warnings.push_back("label " + result.label.text() + " touches itself: " + std::to_string(split.copyOf.size()) +
-                           " vertex copies, " + std::to_string(split.pinchedEdges) + " pinched edges, " +
-                           std::to_string(split.unsplitEdges) +
-                           " of them left with four triangles (docs/theory.md §12, pinches)");
+                           " vertex copies, " + std::to_string(split.pinchedEdges) + " pinched edges (" +
+                           std::to_string(split.joinedEdges) + " taken as joined, " + std::to_string(split.unsplitEdges) +
+                           " left with four triangles or more; docs/theory.md §12, pinches)");
     finishScannedLabel(s, mirrored, o);
     if (smoothing || decimating) {
       double after = 0;

@@ -116,10 +116,11 @@ struct LabelSurface {
   /// of the label for LabelBoundaries::All and Largest, 0 (not counted) with seeds.
   Surface surface;
   /// LabelWalls::Shared: vertex copies made where the label touches itself (pinches), each at the
-  /// same point and surfel as its original; the edges of more than two of its triangles; and
-  /// those of them no copy separates (still of four or more triangles: the surface is a closed
-  /// oriented 2-cycle but not a 2-manifold there).
-  std::size_t pinchCopies = 0, pinchedEdges = 0, unsplitEdges = 0;
+  /// same point and surfel as its original; the edges of more than two of its triangles; those
+  /// of them where the region is taken as joined along the edge, since no copy separates its
+  /// sheets otherwise (docs/theory.md §12, "The exception"); and the edges still of four or more
+  /// triangles after that (the surface a closed oriented 2-cycle but not a 2-manifold there).
+  std::size_t pinchCopies = 0, pinchedEdges = 0, joinedEdges = 0, unsplitEdges = 0;
   /// LabelOptions::smooth: this label's enclosed volume before and after the smoothing and its
   /// largest vertex move (physical units); cubes, unguardedCubes, checkedCubes and stepsBack
   /// are the whole complex's, the same in every label. Nothing without smoothing.
