@@ -27,9 +27,11 @@ std::string labelTableCsv(const std::vector<LabelRow>& rows) {
   const bool tree = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.mergeLevels >= 0; });
   const bool missing = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return !r.noFile.empty(); });
   const bool decimated = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.decimated; });
+  const bool pinched = std::any_of(rows.begin(), rows.end(), [](const LabelRow& r) { return r.pinchCopies || r.pinchedEdges; });
   out << "label,name,voxels,voxel_volume,surfels,triangles,boundaries,euler,genus,area,volume,"
       << (smoothed ? "volume_before_smoothing,max_vertex_displacement," : "")
-      << (decimated ? "triangles_before_decimation,target_triangles,volume_before_decimation," : "") << "file"
+      << (decimated ? "triangles_before_decimation,target_triangles,volume_before_decimation," : "")
+      << (pinched ? "pinch_copies,pinched_edges,joined_edges," : "") << "file"
       << (tree ? ",merge_levels" : "") << (missing ? ",no_file" : "") << "\n";
   for (const LabelRow& r : rows) {
     out << r.label << ',' << csvField(r.name) << ',' << r.voxels << ',' << num(r.voxelVolume, 10) << ','
@@ -38,6 +40,7 @@ std::string labelTableCsv(const std::vector<LabelRow>& rows) {
     if (smoothed) out << num(r.volumeBeforeSmoothing, 10) << ',' << num(r.maxDisplacement, 10) << ',';
     if (decimated)
       out << r.trianglesBeforeDecimation << ',' << r.targetTriangles << ',' << num(r.volumeBeforeDecimation, 10) << ',';
+    if (pinched) out << r.pinchCopies << ',' << r.pinchedEdges << ',' << r.joinedEdges << ',';
     out << csvField(r.file);
     if (tree) out << ',' << (r.mergeLevels >= 0 ? std::to_string(r.mergeLevels) : std::string());
     if (missing) out << ',' << csvField(r.noFile);
@@ -69,6 +72,11 @@ nlohmann::ordered_json labelTableJson(const std::vector<LabelRow>& rows) {
       table.back()["triangles_before_decimation"] = r.trianglesBeforeDecimation;
       table.back()["target_triangles"] = r.targetTriangles;
       table.back()["volume_before_decimation"] = number(r.volumeBeforeDecimation);
+    }
+    if (r.pinchCopies || r.pinchedEdges) {
+      table.back()["pinch_copies"] = r.pinchCopies;
+      table.back()["pinched_edges"] = r.pinchedEdges;
+      table.back()["joined_edges"] = r.joinedEdges;
     }
     if (r.mergeLevels >= 0) table.back()["merge_levels"] = r.mergeLevels;
     if (!r.noFile.empty()) table.back()["no_file"] = r.noFile;

@@ -38,6 +38,10 @@ struct LabelRow {
   bool decimated = false;
   std::size_t trianglesBeforeDecimation = 0, targetTriangles = 0;
   double volumeBeforeDecimation = 0;
+  /// --walls shared: where the label touches itself (docs/theory.md §12, "Pinches"), its vertex
+  /// copies, its edges of more than two triangles and those of them taken as joined. Columns
+  /// only when some row has a pinch.
+  std::size_t pinchCopies = 0, pinchedEdges = 0, joinedEdges = 0;
 };
 
 /// The table as CSV: a header line, then one line per row (a field with a comma or a quote is

@@ -149,9 +149,22 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
     options.decimate = d;
   }
   const std::vector<LabelSurface> surfaces = extractLabels(view, options);
-  if (!o.out.quiet)
-    for (const LabelSurface& l : surfaces)
-      for (const std::string& w : l.surface.warnings) std::cerr << "surftrack: warning: " << w << "\n";
+  if (!o.out.quiet) {
+    // The pinches of shared walls in one line (the table has them label by label), the other
+    // warnings as they are.
+    std::size_t pinchedLabels = 0, copies = 0, pinchedEdges = 0, joined = 0;
+    for (const LabelSurface& l : surfaces) {
+      const bool pinched = l.pinchCopies || l.pinchedEdges;
+      pinchedLabels += pinched, copies += l.pinchCopies, pinchedEdges += l.pinchedEdges, joined += l.joinedEdges;
+      for (const std::string& w : l.surface.warnings)
+        if (!pinched || w.rfind("label " + l.label.text() + " touches itself", 0) != 0)
+          std::cerr << "surftrack: warning: " << w << "\n";
+    }
+    if (pinchedLabels)
+      std::cerr << "surftrack: warning: " << pinchedLabels << " label" << (pinchedLabels == 1 ? " touches itself" : "s touch themselves")
+                << " (pinches, docs/theory.md §12): " << copies << " vertex copies, " << pinchedEdges << " pinched edges, "
+                << joined << " taken as joined; the table's pinch columns list them\n";
+  }
   clock.lap(timings, "extract");
 
   // The rows, and the file of each label.
@@ -185,6 +198,9 @@ LabelsRun writeLabelMeshes(const LabelsOptions& o) {
       r.targetTriangles = ls.decimate->targetTriangles;
       r.volumeBeforeDecimation = ls.decimate->volumeBefore;
     }
+    r.pinchCopies = ls.pinchCopies;
+    r.pinchedEdges = ls.pinchedEdges;
+    r.joinedEdges = ls.joinedEdges;
     if (precomputed) {
       // The segment's manifest (unsharded; sharded, the shard file holds it).
       r.file = o.precomputed.sharded ? o.output

@@ -801,8 +801,9 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
       ->option_text("FILE")
       ->group(which);
   app.add_flag("--no-label-names", o.noNames, "ignore the sidecar names")->group(which);
-  app.add_option("--walls", o.walls, "independent (default): each label against the rest; shared: one\n"
-                 "conforming complex, walls shared triangle for triangle (docs/theory.md)")
+  app.add_option("--walls", o.walls, "shared (default): one conforming complex, walls shared triangle for\n"
+                 "triangle (docs/theory.md); independent: each label against the rest\n"
+                 "(the default with --dask, --largest, --seed, --adjacency 18-6 or 6-18)")
       ->option_text("W")
       ->check(CLI::IsMember({"independent", "shared"}))
       ->group(which);
@@ -951,10 +952,17 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   if (!o.dask.empty() && (o.largest || !o.seeds.empty() || !o.labels.empty() || o.range))
     throw UsageError("--dask meshes every boundary of every label into -o DIR/: not with --labels, --largest "
                      "or --seed yet");
+  if (o.smoothIterations > 0 && !o.dask.empty()) throw UsageError("--smooth is not made by blocks: no --dask");
+  if ((o.maxError || o.reduction) && !o.dask.empty())
+    throw UsageError("--max-error and --reduce are not made by blocks: no --dask");
+  // Shared walls (docs/theory.md §12) are the default wherever they are made: the whole image in
+  // one pass, every boundary, the pairs whose levels are one convex hull per cube.
+  const bool sharedMade = o.dask.empty() && !o.largest && o.seeds.empty() &&
+                          (o.pair == AdjacencyPair::k26_6 || o.pair == AdjacencyPair::k6_26);
+  if (o.walls.empty()) o.walls = sharedMade || o.smoothIterations > 0 || o.maxError || o.reduction ? "shared" : "independent";
   if (o.smoothIterations > 0 && o.walls != "shared")
     throw UsageError("--smooth on labels needs --walls shared: each label smoothed on its own would pull the "
                      "vertices it shares with its neighbours apart");
-  if (o.smoothIterations > 0 && !o.dask.empty()) throw UsageError("--smooth is not made by blocks: no --dask");
   if (o.mergeBudget && o.dask.empty()) throw UsageError("--merge-budget is for --dask (the single pass merges nothing)");
   if (o.mergeBudget && !o.format.empty())
     throw UsageError("--merge-budget is for mesh files: not with --format (Neuroglancer's formats hold every label's "
@@ -962,8 +970,6 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   if ((o.maxError || o.reduction) && o.walls != "shared")
     throw UsageError("--max-error and --reduce on labels need --walls shared: each label decimated on its own "
                      "would no longer share its walls with its neighbours");
-  if ((o.maxError || o.reduction) && !o.dask.empty())
-    throw UsageError("--max-error and --reduce are not made by blocks: no --dask");
   if (o.noNames && !o.labelNames.empty()) throw UsageError("give --label-names or --no-label-names, not both");
   if (!o.unit.empty() && o.format.empty()) throw UsageError("--unit is for --format precomputed or precomputed-multires");
   checkPrecomputedOptions(app, o.format, o.output);

@@ -126,7 +126,9 @@ struct LabelsOptions {
   bool largest = false;                            ///< --largest
   std::vector<Voxel> seeds;                        ///< --seed x,y,z (repeatable)
   AdjacencyPair pair = AdjacencyPair::k26_6;
-  std::string walls = "independent";               ///< --walls independent|shared
+  /// --walls independent|shared; empty until parsed, then shared unless it is not made for the
+  /// other options (--dask, --largest, --seed, --adjacency 18-6 or 6-18), then independent.
+  std::string walls;
   int smoothIterations = 0;                        ///< --smooth [N] (shared walls): 0 none
   std::optional<double> maxError;                  ///< --max-error E (shared walls): decimation
   std::optional<double> reduction;                 ///< --reduce F (shared walls): decimation

@@ -143,6 +143,7 @@ PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
   });
   PinchSplit out;
   pairAndCopy(points, triangles, sides, {}, out);
+  if (out.pinchedEdges == 0) return out;  // (copies never crowd an edge)
   std::size_t crowded = 0;
   std::vector<std::uint64_t> joined = crowdedEdges(points.size(), out, crowded);
   if (!joined.empty()) {

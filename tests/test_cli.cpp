@@ -1051,7 +1051,7 @@ TEST_F(Cli, LabelsWritesADirectoryOfClosedMeshesAndATable) {
   io::writeVolume(io::AnyVolume(image), in);
   std::ofstream(names) << "# value name\n1 Left_thing\n2 Right 99\n7 Middle 1234\n";
   const std::string dir = path("out/"), table = path("table.json");
-  const RunResult r = run({"labels", in, "-o", dir, "--label-names", names, "--table", table, "--json"});
+  const RunResult r = run({"labels", in, "--walls", "independent", "-o", dir, "--label-names", names, "--table", table, "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::map<int, std::string> files = {{1, "1_Left_thing.ply"}, {2, "2_Right.ply"},
                                             {7, "7_Middle.ply"}, {9, "9_label9.ply"}};
@@ -1079,7 +1079,7 @@ TEST_F(Cli, LabelsWritesOnePlyWithALabelPerFaceAndPatterns) {
   const DenseImage<std::uint16_t> image = labelBalls();
   const std::string in = path("labels.nrrd");
   io::writeVolume(io::AnyVolume(image), in);
-  const RunResult r = run({"labels", in, "-o", path("all.ply"), "--labels", "1,7", "--ascii", "--quiet"});
+  const RunResult r = run({"labels", in, "--walls", "independent", "-o", path("all.ply"), "--labels", "1,7", "--ascii", "--quiet"});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::size_t s1 = countBoundarySurfels(image, [](std::uint16_t v) { return v == 1; });
   const std::size_t s7 = countBoundarySurfels(image, [](std::uint16_t v) { return v == 7; });
@@ -1102,7 +1102,7 @@ TEST_F(Cli, LabelsWritesOnePlyWithALabelPerFaceAndPatterns) {
   EXPECT_EQ(faces[1], 2 * s1 - 4);  // one sphere each: F = 2V - 4
   EXPECT_EQ(faces[7], 2 * s7 - 4);
 
-  const RunResult p = run({"labels", in, "-o", path("mesh-{label}.obj"), "--labels", "2-7", "--quiet"});
+  const RunResult p = run({"labels", in, "--walls", "independent", "-o", path("mesh-{label}.obj"), "--labels", "2-7", "--quiet"});
   ASSERT_EQ(p.code, 0) << p.err;
   EXPECT_TRUE(fs::exists(path("mesh-2.obj")));
   EXPECT_TRUE(fs::exists(path("mesh-7.obj")));
@@ -1117,7 +1117,7 @@ TEST_F(Cli, LabelsPatternFailingMidwayLeavesNoFile) {
   std::ofstream(path("pattern/mesh-1.ply")) << "old";  // an old output, to be kept as it is
   // Label 7's target is a directory: the labels before it are written, then the run fails.
   fs::create_directories(path("pattern/mesh-7.ply"));
-  expectFailure({"labels", in, "-o", path("pattern/mesh-{label}.ply")}, 1, "is a directory");
+  expectFailure({"labels", in, "--walls", "independent", "-o", path("pattern/mesh-{label}.ply")}, 1, "is a directory");
   std::vector<std::string> left;
   for (const auto& e : fs::directory_iterator(path("pattern"))) left.push_back(e.path().filename().string());
   std::sort(left.begin(), left.end());

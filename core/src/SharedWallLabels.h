@@ -11,7 +11,8 @@
 // LabelOptions::decimate the complex (smoothed or not) is decimated wall by wall
 // (WallDecimation.h), and each label's triangles are its walls' survivors, over its own vertices
 // (a pinch's copies kept where they were: the decimation never touches a pinch).
-// One thread for the scan; the labels' meshes are the same for any `threads`.
+// One thread for the scan, the labels' meshes then finished in parallel; the same for any
+// `threads`.
 #pragma once
 
 #include <algorithm>
@@ -19,8 +20,13 @@
 #include <cstdint>
 #include <string>
 #include <unordered_map>
+#include <numeric>
 #include <utility>
 #include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "BoundaryMapping.h"
 #include "ComplexSmoothing.h"
@@ -189,11 +195,21 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
 
   // 4. Pinches split, vertices placed (midpoint mapping, then the geometry, or the smoothed
   //    complex's points), figures.
-  std::vector<LabelSurface> out;
-  out.reserve(selected.size());
-  for (std::size_t k = 0; k < selected.size(); ++k) {
+  //    The labels are independent here: in parallel on `threads`, largest first so that the
+  //    last to finish are small (each label's mesh is the same for any count).
+  std::vector<LabelSurface> out(selected.size());
+  std::vector<std::size_t> order(selected.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return building[a].triangles.size() > building[b].triangles.size(); });
+  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+  for (std::size_t at = range.begin(); at < range.end(); ++at) {
+    const std::size_t k = order[at];
     if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
     Building& b = building[k];
+    std::unordered_map<std::uint64_t, std::uint32_t>().swap(b.vertexOf);  // done with it
     std::vector<std::array<double, 3>> doubled(b.surfels.size());  // exact: 2 x the midpoint
     for (std::size_t v = 0; v < b.surfels.size(); ++v) {
       const Voxel c = b.surfels[v].inside(), d = b.surfels[v].outside();
@@ -205,8 +221,8 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     } catch (const std::logic_error& e) {
       throw InternalError(std::string("shared walls: ") + e.what());
     }
-    out.push_back(labelFields(geometry, LabelValue(labels[selected[k]]), voxels[selected[k] + 1], o));
-    LabelSurface& result = out.back();
+    out[k] = labelFields(geometry, LabelValue(labels[selected[k]]), voxels[selected[k] + 1], o);
+    LabelSurface& result = out[k];
     Surface& s = result.surface;
     s.surfels = std::move(b.surfels);
     for (std::uint32_t v : split.copyOf) s.surfels.push_back(s.surfels[v]);
@@ -303,6 +319,8 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
       if (decimating) result.decimate->volumeAfter = after;
     }
   }
+  });
+  });
   return out;
 }
 

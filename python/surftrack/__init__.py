@@ -415,7 +415,7 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
                    background: int = 0, boundaries: str = "all", seeds: Optional[Sequence] = None,
                    adjacency: str = "26-6", spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
                    direction=None, affine=None, threads: int = 0, figures: bool = True,
-                   walls: str = "independent", smooth: int = 0, max_error: Optional[float] = None,
+                   walls: Optional[str] = None, smooth: int = 0, max_error: Optional[float] = None,
                    reduce: Optional[float] = None) -> dict:
     """Every label of an integer label image as a closed surface: a dict label -> Surface.
 
@@ -429,8 +429,9 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     axis) from each seed to its label's boundary, and only their labels. Geometry as in
     ``extract``. ``walls="shared"`` makes all the labels one conforming complex (every wall one
     set of triangles used by both its labels, space partitioned exactly; docs/theory.md, "Shared
-    walls"; every boundary only: no seeds, not "largest"); "independent" (default) meshes each
-    label against the rest. ``smooth=N`` (shared walls only) smooths the whole complex with
+    walls"; every boundary only: no seeds, not "largest"; adjacency 26-6 or 6-26);
+    "independent" meshes each label against the rest. The default (None) is "shared" wherever it
+    is made, "independent" with seeds, "largest" or the adjacencies 18-6 and 6-18. ``smooth=N`` (shared walls only) smooths the whole complex with
     N Taubin iterations as ``extract``'s smooth does one surface: every vertex moves once, to the
     same point in every label, along its surfel's segment, so each wall stays shared, space stays
     partitioned and each label keeps its voxels and topology (docs/theory.md §12, "Smoothing the
@@ -456,6 +457,9 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     if adjacency not in _ADJACENCIES:
         raise ValueError(f"unsupported adjacency pair '{adjacency}': expected one of "
                          + ", ".join(_ADJACENCIES))
+    if walls is None:  # shared walls wherever they are made (docs/theory.md §12)
+        made = boundaries == "all" and seeds is None and adjacency in ("26-6", "6-26")
+        walls = "shared" if made or smooth or max_error is not None or reduce is not None else "independent"
     if walls not in ("independent", "shared"):
         raise ValueError(f"unknown walls '{walls}': expected 'independent' or 'shared'")
     if isinstance(smooth, bool) or int(smooth) != smooth or smooth < 0:

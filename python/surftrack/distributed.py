@@ -426,7 +426,8 @@ def _require_memory(client, block, itemsize):
 def label_surfaces(labels, *, block=(256, 256, 256), spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
                    direction=None, background=0, adjacency="26-6", figures=True, client=None, workers=None,
                    work_dir=None, shards=None, progress=None) -> dict:
-    """``surftrack.label_surfaces(labels, ...)`` computed by blocks on Dask: the same dict of
+    """``surftrack.label_surfaces(labels, walls="independent", ...)`` computed by blocks on Dask
+    (shared walls are not made by blocks): the same dict of
     label -> Surface, array for array. ``labels`` is a 3-D integer array read by slicing (a zarr
     array, a numpy array, a memory map). ``client``: a ``dask.distributed.Client`` (any cluster);
     None starts a LocalCluster of ``workers`` processes for the call. ``work_dir`` holds the
@@ -449,9 +450,9 @@ def write_label_meshes(labels, out_dir, *, block=(256, 256, 256), spacing=(1.0, 
                        merge_budget=None) -> dict:
     """Every label's surface written into ``out_dir`` by the reduce tasks. ``format="ply"``: one
     file ``label_<L>.ply`` a label, each byte-identical to ``surftrack.label_surfaces(labels,
-    ...)[L].write(...)`` on the whole array. ``format="precomputed"`` or
+    walls="independent", ...)[L].write(...)`` on the whole array. ``format="precomputed"`` or
     ``"precomputed-multires"``: Neuroglancer's directory, every file byte-identical to
-    ``surftrack.write_precomputed(surftrack.label_surfaces(labels, ...), out_dir, axes=axes,
+    ``surftrack.write_precomputed(surftrack.label_surfaces(labels, walls="independent", ...), out_dir, axes=axes,
     unit=unit, spacing=spacing, names=names, lods=lods, sharded=sharded,
     quantization_bits=quantization_bits)`` (``lods`` 3 by default for the multi-resolution
     format; ``axes`` required). ``out_dir`` (shared by the workers) must not exist or be empty;

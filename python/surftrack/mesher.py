@@ -73,8 +73,9 @@ class Mesher:
         if array.dtype.kind not in "biu":
             raise ValueError(f"Mesher.mesh needs integer labels, not {array.dtype} voxels")
         # (all background: no mesh, as zmesh, where label_surfaces calls the selection empty)
+        # Each label against the rest, as zmesh meshes it (and at the engine's full speed).
         self._surfaces = label_surfaces(array, spacing=self.anisotropy, background=0, threads=threads,
-                                        figures=False) if array.any() else {}
+                                        figures=False, walls="independent") if array.any() else {}
         self._labels = array
 
     def ids(self) -> list:

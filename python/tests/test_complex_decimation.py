@@ -98,9 +98,9 @@ def test_decimated_walls_stay_shared(rng):
 def test_decimation_needs_shared_walls_and_good_values():
     labels = np.ones((3, 3, 3), np.uint8)
     with pytest.raises(ValueError, match="shared"):
-        surftrack.label_surfaces(labels, max_error=0.5)
+        surftrack.label_surfaces(labels, walls="independent", max_error=0.5)
     with pytest.raises(ValueError, match="shared"):
-        surftrack.label_surfaces(labels, reduce=0.5)
+        surftrack.label_surfaces(labels, walls="independent", reduce=0.5)
     with pytest.raises(ValueError, match="max error"):
         shared(labels, max_error=-1.0)
     with pytest.raises(ValueError, match="reduction"):
@@ -147,6 +147,7 @@ def test_cli_decimation(tmp_path, rng):
         if twin is None:
             p = np.array(tri)
             assert np.all(np.any((p == -0.5) | (p == np.array([6, 7, 8]) - 0.5), axis=1))
-    r = subprocess.run([cli(), "labels", "a.raw", *raw, "-o", "all.ply", "--max-error", "0.5"], cwd=tmp_path,
+    r = subprocess.run([cli(), "labels", "a.raw", *raw, "-o", "all.ply", "--walls", "independent", "--max-error", "0.5"],
+                       cwd=tmp_path,
                        capture_output=True, text=True)
     assert r.returncode != 0 and "--walls shared" in r.stderr and len(r.stderr.strip().splitlines()) == 1

@@ -73,7 +73,7 @@ def test_smoothed_walls_stay_shared_and_space_stays_partitioned(rng):
 def test_smooth_needs_shared_walls():
     labels = np.ones((3, 3, 3), np.uint8)
     with pytest.raises(ValueError, match="shared"):
-        surftrack.label_surfaces(labels, smooth=5)
+        surftrack.label_surfaces(labels, walls="independent", smooth=5)
     with pytest.raises(ValueError, match="smooth"):
         shared(labels, smooth=-1)
     assert not getattr(shared(labels, smooth=0)[1], "refine", None)
@@ -100,6 +100,7 @@ def test_cli_smooth(tmp_path, rng):
                        cwd=tmp_path, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout)["smooth_iterations"] == 50
-    r = subprocess.run([cli(), "labels", "a.raw", *raw, "-o", "all.ply", "--smooth", "5"], cwd=tmp_path,
+    r = subprocess.run([cli(), "labels", "a.raw", *raw, "-o", "all.ply", "--walls", "independent", "--smooth", "5"],
+                       cwd=tmp_path,
                        capture_output=True, text=True)
     assert r.returncode != 0 and "--walls shared" in r.stderr and len(r.stderr.strip().splitlines()) == 1

@@ -61,7 +61,7 @@ def test_blocks_merge_to_the_single_pass(client, adjacency):
     for block in [(4, 3, 5), (1, 6, 2), (20, 20, 20), (5, 1, 7)]:
         labels = random_labels(rng, tuple(rng.integers(7, 12, size=3)))
         spacing = tuple(float(v) for v in rng.choice([0.5, 1.0, 4.0], size=3))
-        want = surftrack.label_surfaces(labels, spacing=spacing, origin=(1, -2, 3), adjacency=adjacency)
+        want = surftrack.label_surfaces(labels, spacing=spacing, origin=(1, -2, 3), adjacency=adjacency, walls="independent")
         got = blocks.label_surfaces(labels, block=block, spacing=spacing, origin=(1, -2, 3),
                                     adjacency=adjacency, client=client)
         expect_same(got, want)
@@ -86,7 +86,7 @@ def test_zarr_store_gives_byte_identical_files_and_resumes(client, tmp_path):
     figures = blocks.write_label_meshes(source, out, block=(34, 26, 22), spacing=(2.0, 1.5, 1.0),
                                         client=client, work_dir=work,
                                         progress=lambda stage, done, total: seen.append((stage, done, total)))
-    want = surftrack.label_surfaces(labels, spacing=(2.0, 1.5, 1.0))
+    want = surftrack.label_surfaces(labels, spacing=(2.0, 1.5, 1.0), walls="independent")
     assert sorted(figures) == sorted(want) and len(want) == 39
     reference = tmp_path / "reference"
     reference.mkdir()
@@ -138,7 +138,7 @@ def _killed_mid_run(client, tmp_path):
 
     got = blocks.label_surfaces(KillsItsWorkerOnce(labels, marker), block=(5, 4, 6), client=client)
     assert marker.exists()
-    expect_same(got, surftrack.label_surfaces(labels))
+    expect_same(got, surftrack.label_surfaces(labels, walls="independent"))
     client.wait_for_workers(2)
 
 
@@ -166,7 +166,7 @@ def test_a_work_dir_reused_with_other_arguments_recomputes(client, tmp_path):
     work = tmp_path / "fragments"
     blocks.label_surfaces(labels, block=(5, 5, 5), client=client, work_dir=work)
     other = blocks.label_surfaces(labels, block=(5, 5, 5), client=client, work_dir=work, background=int(IDS[1]))
-    expect_same(other, surftrack.label_surfaces(labels, background=int(IDS[1])))
+    expect_same(other, surftrack.label_surfaces(labels, background=int(IDS[1]), walls="independent"))
     assert len(list(work.iterdir())) == 2 * len(blocks.block_grid(labels.shape, (5, 5, 5)))
 
 
@@ -181,7 +181,7 @@ def test_labels_over_the_merge_budget_get_exact_figures_and_streamed_files(clien
     grid = np.stack(np.indices(shape), axis=-1).reshape(-1, 1, 3)
     labels = np.argmin(((grid - seeds[None]) ** 2).sum(-1), axis=1).reshape(shape).astype(np.int32) - 2
     labels[rng.random(shape) < 0.05] = 7  # specks: many components
-    want = surftrack.label_surfaces(labels, spacing=(2.0, 1.0, 0.5))
+    want = surftrack.label_surfaces(labels, spacing=(2.0, 1.0, 0.5), walls="independent")
     # A first run writes the fragment files, whose sizes set a budget half the labels exceed.
     work = tmp_path / "work"
     blocks.write_label_meshes(labels, tmp_path / "first", block=(4, 5, 3), client=client, work_dir=work)
@@ -313,7 +313,7 @@ def test_cli_labels_on_dask_writes_the_single_pass_files_and_table(tmp_path):
     for extra in [[], ["--level", 1, "--ascii", "--spacing", "1,2,3", "--adjacency", "6-26"]]:
         single, dask = tmp_path / f"single{len(extra)}", tmp_path / f"dask{len(extra)}"
         common = ["--label-names", names, *extra]
-        a = run_cli("labels", store, "-o", f"{single}/", *common, "--table", tmp_path / "a.json")
+        a = run_cli("labels", store, "--walls", "independent", "-o", f"{single}/", *common, "--table", tmp_path / "a.json")
         assert a.returncode == 0, a.stderr
         b = run_cli("labels", store, "-o", f"{dask}/", *common, "--table", tmp_path / "b.json", "--dask", "local:2",
                     "--block", "16,10,12", "--work-dir", tmp_path / f"work{len(extra)}")
@@ -389,7 +389,7 @@ def test_cli_labels_on_dask_with_a_merge_budget(tmp_path):
     cells[rng.random(shape) < 0.04] = 9  # specks: a label of many components
     zarr.open(str(tmp_path / "s.zarr"), mode="w", shape=shape, chunks=(9, 8, 7), dtype="<u2")[:] = cells
     single = tmp_path / "single"
-    a = run_cli("labels", tmp_path / "s.zarr", "-o", f"{single}/", "--table", tmp_path / "a.json")
+    a = run_cli("labels", tmp_path / "s.zarr", "--walls", "independent", "-o", f"{single}/", "--table", tmp_path / "a.json")
     assert a.returncode == 0, a.stderr
     work = tmp_path / "work"
     first = run_cli("labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/first/", "--dask", "local:2", "--block",
@@ -450,7 +450,7 @@ def test_cli_merge_budget_bad_input(tmp_path):
              (["--dask", "local:2", "--merge-budget", "99999999999G"], "not a number of bytes"),
              (["--dask", "local:2", "--merge-budget", "1G", "--format", "precomputed"], "not with --format")]
     for args, says in cases:
-        r = run_cli("labels", tmp_path / "s.zarr", "-o", f"{tmp_path}/out/", *args)
+        r = run_cli("labels", tmp_path / "s.zarr", "--walls", "independent", "-o", f"{tmp_path}/out/", *args)
         assert r.returncode != 0 and says in r.stderr and r.stderr.count("\n") == 1, (args, r.stderr)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr"]
 

@@ -73,7 +73,7 @@ def test_blocks_write_the_single_pass_directory(client, tmp_path, case):
         axes, unit = ["zyx", "xyz"][run % 2], ["nm", "um", "mm"][run % 3]
         present = [int(L) for L in np.unique(labels) if L]
         names = {L: f"cell {i}" for i, L in enumerate(present) if i % 2} if run % 2 else None
-        surfaces = surftrack.label_surfaces(labels, spacing=spacing, origin=(1, -2, 3))
+        surfaces = surftrack.label_surfaces(labels, spacing=spacing, origin=(1, -2, 3), walls="independent")
         want = tmp_path / f"single{run}"
         lods = options.get("lods") if fmt == "precomputed-multires" else None
         surftrack.write_precomputed(surfaces, want, axes=axes, unit=unit, spacing=spacing, names=names, lods=lods,
@@ -103,7 +103,7 @@ def test_many_shards(client, tmp_path):
     cells = np.argwhere(np.indices(shape).sum(0) % 2 == 0)[:count]  # single voxels, none touching by a face
     labels[tuple(cells.T)] = np.arange(1, len(cells) + 1, dtype=np.uint32) * 7
     assert len(cells) == count
-    surfaces = surftrack.label_surfaces(labels)
+    surfaces = surftrack.label_surfaces(labels, walls="independent")
     want, got = tmp_path / "single", tmp_path / "dask"
     surftrack.write_precomputed(surfaces, want, axes="zyx", spacing=(1, 1, 1), lods=1, sharded=True)
     blocks.write_label_meshes(labels, got, block=(17, 34, 12), client=client, format="precomputed-multires",
@@ -115,7 +115,7 @@ def test_many_shards(client, tmp_path):
 def test_on_worker_processes(tmp_path):
     rng = np.random.default_rng(7)
     labels = random_labels(rng, (11, 9, 10), np.uint64)
-    surfaces = surftrack.label_surfaces(labels)
+    surfaces = surftrack.label_surfaces(labels, walls="independent")
     surftrack.write_precomputed(surfaces, tmp_path / "single", axes="zyx", spacing=(1, 1, 1), lods=2, sharded=True)
     blocks.write_label_meshes(labels, tmp_path / "dask", block=(5, 4, 7), workers=2, format="precomputed-multires",
                               axes="zyx", lods=2, sharded=True)
@@ -146,7 +146,7 @@ def test_bad_input_writes_nothing(client, tmp_path):
     far = np.zeros((12, 6, 6), np.uint16)
     far[0:2, 0:2, 0:2], far[9:11, 3:5, 3:5] = 1, 2
     with pytest.raises(ValueError, match="beyond a float32"):
-        surftrack.write_precomputed(surftrack.label_surfaces(far, spacing=(1e29, 1, 1)), tmp_path / "single",
+        surftrack.write_precomputed(surftrack.label_surfaces(far, spacing=(1e29, 1, 1), walls="independent"), tmp_path / "single",
                                     axes="zyx", unit="m", spacing=(1e29, 1, 1))
     with pytest.raises(ValueError, match="beyond a float32"):
         blocks.write_label_meshes(far, tmp_path / "out", block=(6, 6, 6), spacing=(1e29, 1, 1), client=client,
@@ -183,7 +183,7 @@ def test_cli_labels_on_dask_writes_the_single_pass_directory(tmp_path):
                              ["precomputed-multires", "--lods", "1", "--sharded", "--shard-hash", "identity"]]):
         single, dask = tmp_path / f"single-{i}", tmp_path / f"dask-{i}"
         common = ["--label-names", names, "--format", *fmt]
-        a = run_cli("labels", store, "-o", f"{single}/", *common, "--table", tmp_path / "a.csv")
+        a = run_cli("labels", store, "--walls", "independent", "-o", f"{single}/", *common, "--table", tmp_path / "a.csv")
         assert a.returncode == 0, a.stderr
         b = run_cli("labels", store, "-o", f"{dask}/", *common, "--table", tmp_path / "b.csv", "--dask", "local:2",
                     "--block", "10,6,8")

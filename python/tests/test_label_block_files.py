@@ -61,7 +61,7 @@ def test_merged_from_files_is_the_single_pass(tmp_path):
         folder = tmp_path / str(trial)
         folder.mkdir()
         paths = write_blocks(labels, block, folder, adjacency)
-        want = surftrack.label_surfaces(labels, spacing=(0.5, 1.0, 4.0), origin=(1, -2, 3), adjacency=adjacency)
+        want = surftrack.label_surfaces(labels, spacing=(0.5, 1.0, 4.0), origin=(1, -2, 3), adjacency=adjacency, walls="independent")
         summaries = [_surftrack.fragment_file_summary(p) for p in paths]
         assert sorted({s[0] for summary in summaries for s in summary}) == sorted(want)
         for label, w in want.items():
@@ -152,7 +152,7 @@ def test_tree_figures_are_the_single_pass(tmp_path, levels, block):
         folder = tmp_path / str(trial)
         folder.mkdir()
         paths = write_blocks(labels, block, folder)
-        want = surftrack.label_surfaces(labels, spacing=spacing, origin=(1, -2, 3), direction=np.array(direction))
+        want = surftrack.label_surfaces(labels, spacing=spacing, origin=(1, -2, 3), direction=np.array(direction), walls="independent")
         deepest = 0
         for label, w in want.items():
             # Budget 0: down to single blocks, so the tree's depth is that of the block grid.
@@ -202,7 +202,7 @@ def test_streamed_mesh_is_the_single_pass_file(tmp_path):
         paths = write_blocks(labels, block, folder, adjacency)
         direction = MIRROR if trial % 2 else IDENTITY
         want = surftrack.label_surfaces(labels, spacing=(0.5, 1.0, 4.0), origin=(1, -2, 3), direction=direction,
-                                        adjacency=adjacency)
+                                        adjacency=adjacency, walls="independent")
         out = tmp_path / "out"
         out.mkdir(exist_ok=True)
         for label, w in want.items():

@@ -26,7 +26,7 @@ def test_every_label_is_closed_and_counted(rng, dtype):
     for trial in range(6):
         labels = voronoi(rng, (14, 11, 9), int(rng.integers(2, 12)), dtype)
         labels[rng.random(labels.shape) < 0.05] = 0  # background specks
-        surfaces = surftrack.label_surfaces(labels, spacing=(0.5, 1.0, 2.0))
+        surfaces = surftrack.label_surfaces(labels, spacing=(0.5, 1.0, 2.0), walls="independent")
         present = sorted(int(v) for v in np.unique(labels) if v != 0)
         assert sorted(surfaces) == present
         for label, s in surfaces.items():
@@ -57,10 +57,10 @@ def test_random_label_images_give_the_same_arrays_on_1_2_7_threads(seed):
     cells[rng.random(shape) < 0.03] = 0
     for labels in (noise, cells):
         for boundaries in ("all", "largest"):
-            ref = surftrack.label_surfaces(labels, boundaries=boundaries, threads=1)
+            ref = surftrack.label_surfaces(labels, boundaries=boundaries, threads=1, walls="independent")
             assert len(ref) > 5
             for threads in (2, 7):
-                got = surftrack.label_surfaces(labels, boundaries=boundaries, threads=threads)
+                got = surftrack.label_surfaces(labels, boundaries=boundaries, threads=threads, walls="independent")
                 assert sorted(got) == sorted(ref)
                 for label, s in got.items():
                     r = ref[label]
@@ -71,7 +71,7 @@ def test_random_label_images_give_the_same_arrays_on_1_2_7_threads(seed):
 
 def test_touching_labels_share_their_interface_vertices(rng):
     labels = voronoi(rng, (16, 16, 16), 6, np.uint16)
-    surfaces = surftrack.label_surfaces(labels)
+    surfaces = surftrack.label_surfaces(labels, walls="independent")
     points = {label: set(map(tuple, s.vertices.tolist())) for label, s in surfaces.items()}
     # Every pair of 6-adjacent voxels of two labels: its midpoint is a vertex of both.
     pairs = 0
@@ -90,17 +90,17 @@ def test_touching_labels_share_their_interface_vertices(rng):
 def test_selection_and_bad_input(rng):
     labels = voronoi(rng, (10, 10, 10), 4, np.uint16)
     present = sorted(int(v) for v in np.unique(labels))
-    assert sorted(surftrack.label_surfaces(labels, only=[present[1]])) == [present[1]]
-    assert sorted(surftrack.label_surfaces(labels, label_range=(present[0], present[1]))) == present[:2]
-    largest = surftrack.label_surfaces(labels, boundaries="largest")
+    assert sorted(surftrack.label_surfaces(labels, only=[present[1]], walls="independent")) == [present[1]]
+    assert sorted(surftrack.label_surfaces(labels, label_range=(present[0], present[1]), walls="independent")) == present[:2]
+    largest = surftrack.label_surfaces(labels, boundaries="largest", walls="independent")
     assert all(len(s.components) == 1 for s in largest.values())
     with pytest.raises(ValueError, match="integer voxels"):
-        surftrack.label_surfaces(labels.astype(np.float32))
+        surftrack.label_surfaces(labels.astype(np.float32), walls="independent")
     with pytest.raises(ValueError, match="does not occur"):
-        surftrack.label_surfaces(labels, only=[999])
+        surftrack.label_surfaces(labels, only=[999], walls="independent")
     with pytest.raises(ValueError, match="empty selection"):
-        surftrack.label_surfaces(labels, only=[])
+        surftrack.label_surfaces(labels, only=[], walls="independent")
     with pytest.raises(ValueError, match="empty selection"):
-        surftrack.label_surfaces(labels, label_range=(500, 600))
-    seeded = surftrack.label_surfaces(labels, seeds=[(0, 0, 0)], background=999)
+        surftrack.label_surfaces(labels, label_range=(500, 600), walls="independent")
+    seeded = surftrack.label_surfaces(labels, seeds=[(0, 0, 0)], background=999, walls="independent")
     assert list(seeded) == [int(labels[0, 0, 0])]

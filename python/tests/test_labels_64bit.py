@@ -43,7 +43,7 @@ def boundary_faces(a, label):
 def test_label_surfaces_keeps_every_id_exact(seed):
     a = volume(seed)
     present = sorted(int(v) for v in np.unique(a) if v != 0)
-    surfaces = surftrack.label_surfaces(a)
+    surfaces = surftrack.label_surfaces(a, walls="independent")
     assert sorted(surfaces) == present
     for label, s in surfaces.items():
         assert type(label) is int
@@ -52,9 +52,9 @@ def test_label_surfaces_keeps_every_id_exact(seed):
         alone = surftrack.extract(a, label=label, mode="all")
         assert len(alone.vertices) == len(s.vertices)
     only = present[1:3]
-    assert sorted(surftrack.label_surfaces(a, only=only)) == only
-    assert sorted(surftrack.label_surfaces(a, only=np.array(only, np.uint64))) == only
-    assert sorted(surftrack.label_surfaces(a, label_range=(present[1], present[-1]))) == present[1:]
+    assert sorted(surftrack.label_surfaces(a, only=only, walls="independent")) == only
+    assert sorted(surftrack.label_surfaces(a, only=np.array(only, np.uint64), walls="independent")) == only
+    assert sorted(surftrack.label_surfaces(a, label_range=(present[1], present[-1]), walls="independent")) == present[1:]
 
 
 def test_a_seed_selects_its_own_64_bit_label():
@@ -76,7 +76,7 @@ def test_labels_that_are_not_values_are_refused(bad, error):
     with pytest.raises(error):
         surftrack.extract(a, label=bad, mode="all")
     with pytest.raises(error):
-        surftrack.label_surfaces(a, only=[bad])
+        surftrack.label_surfaces(a, only=[bad], walls="independent")
 
 
 PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "<i2", "ushort": "<u2", "int": "<i4", "uint": "<u4",
@@ -130,7 +130,7 @@ def test_cli_mesh_labels_table_and_ply_are_exact(tmp_path):
     assert r.returncode != 0 and "not an integer label" in r.stderr
     assert not (tmp_path / "x.ply").exists()
 
-    r = run("labels", "seg.raw", *raw, "-o", "out/", "--quiet", cwd=tmp_path)
+    r = run("labels", "seg.raw", "--walls", "independent", *raw, "-o", "out/", "--quiet", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     with open(tmp_path / "out" / "labels.csv") as f:
         rows = list(csv.DictReader(f))
@@ -139,7 +139,7 @@ def test_cli_mesh_labels_table_and_ply_are_exact(tmp_path):
         assert int(row["voxels"]) == int(np.count_nonzero(a == np.uint64(int(row["label"]))))
         assert row["label"] in row["file"]
 
-    r = run("labels", "seg.raw", *raw, "-o", "all.ply", "--labels", f"{present[1]}-{present[-1]}", "--quiet",
+    r = run("labels", "seg.raw", "--walls", "independent", *raw, "-o", "all.ply", "--labels", f"{present[1]}-{present[-1]}", "--quiet",
             cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     ply = read_ply(tmp_path / "all.ply")
@@ -149,7 +149,7 @@ def test_cli_mesh_labels_table_and_ply_are_exact(tmp_path):
         low = ply[element]["label_low"].astype(np.uint64)
         labels = (high << np.uint64(32)) | low
         assert sorted(int(v) for v in np.unique(labels)) == present[1:]
-    surfaces = surftrack.label_surfaces(a)
+    surfaces = surftrack.label_surfaces(a, walls="independent")
     for label in present[1:]:  # the face labels: each label's triangles
         assert int(np.count_nonzero(labels == np.uint64(label))) == len(surfaces[label].faces)
     vertex_labels = (ply["vertex"]["label_high"].astype(np.uint64) << np.uint64(32)) | ply["vertex"]["label_low"]
@@ -162,7 +162,7 @@ def test_cli_small_labels_keep_the_int_property(tmp_path):
     a[1:3, 1:3, 1:3] = -5
     a[3:5, 3:5, 3:5] = 7
     a.tofile(tmp_path / "small.raw")
-    r = run("labels", "small.raw", "--raw-dims", "6,6,6", "--raw-type", "int64", "-o", "all.ply", "--quiet",
+    r = run("labels", "small.raw", "--walls", "independent", "--raw-dims", "6,6,6", "--raw-type", "int64", "-o", "all.ply", "--quiet",
             cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     ply = read_ply(tmp_path / "all.ply")
@@ -175,7 +175,7 @@ def test_cli_negative_wide_labels_are_signed_words(tmp_path):
     a[1:3, 1:3, 1:3] = -(2**40) - 3
     a[3:5, 3:5, 3:5] = 2**62 + 1
     a.tofile(tmp_path / "wide.raw")
-    r = run("labels", "wide.raw", "--raw-dims", "6,6,6", "--raw-type", "int64", "-o", "all.ply", "--quiet",
+    r = run("labels", "wide.raw", "--walls", "independent", "--raw-dims", "6,6,6", "--raw-type", "int64", "-o", "all.ply", "--quiet",
             cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     ply = read_ply(tmp_path / "all.ply")

@@ -74,7 +74,7 @@ def test_segments_are_the_labels_voxel_faces_in_nanometres(tmp_path):
         if not labels.any():
             continue
         spacing = tuple(float(v) for v in rng.choice([0.004, 0.04, 0.5], size=3))  # micrometres
-        surfaces = surftrack.label_surfaces(labels, spacing=spacing)
+        surfaces = surftrack.label_surfaces(labels, spacing=spacing, walls="independent")
         out = tmp_path / f"case{case}"
         surftrack.write_precomputed(surfaces, out, axes="zyx", unit="um", spacing=spacing,
                                     names={2**64 - 1: "the last id"})
@@ -112,7 +112,7 @@ def test_cli_and_python_write_the_same_bytes(tmp_path):
                           "--format", "precomputed", "-o", str(cli_out) + "/", "--quiet"],
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    surfaces = surftrack.label_surfaces(labels, spacing=spacing_xyz[::-1])
+    surfaces = surftrack.label_surfaces(labels, spacing=spacing_xyz[::-1], walls="independent")
     py_out = tmp_path / "py"
     surftrack.write_precomputed(surfaces, py_out, axes="zyx", unit="nm", spacing=spacing_xyz[::-1])
     files = sorted(os.listdir(cli_out))
@@ -144,7 +144,7 @@ def test_bad_output_is_refused_and_nothing_written(tmp_path):
     refused(["--unit", "nm", "-o", str(tmp_path / "m.ply")], "directory")
     refused(["--unit", "nm", "--background", "3", "-o", str(tmp_path / "b") + "/"], "positive uint64")
 
-    surfaces = surftrack.label_surfaces(labels)
+    surfaces = surftrack.label_surfaces(labels, walls="independent")
     with pytest.raises(ValueError, match="axes"):
         surftrack.write_precomputed(surfaces, tmp_path / "p", axes="yxz")
     with pytest.raises(ValueError, match="unit"):

@@ -299,7 +299,7 @@ def test_levels_are_closed_oriented_and_match_the_label(tmp_path, bits, lods, sh
         labels = boxes_volume(rng, (20, 18, 16), ids)
         labels = np.maximum(labels, torus(labels.shape, (9, 9, 8), 5, 2, 9))
         spacing = tuple(float(v) for v in rng.choice([0.004, 0.04], size=3))
-        surfaces = surftrack.label_surfaces(labels, spacing=spacing)
+        surfaces = surftrack.label_surfaces(labels, spacing=spacing, walls="independent")
         out = tmp_path / f"case{case}"
         surftrack.write_precomputed(surfaces, out, axes="zyx", unit="um", spacing=spacing,
                                     lods=lods, sharded=sharded, quantization_bits=bits,
@@ -347,7 +347,7 @@ def read_legacy_vertices(path, segid):
 def test_transform_puts_level_zero_where_the_legacy_format_puts_the_mesh(tmp_path):
     labels = torus((16, 20, 22), (8, 10, 11), 6, 2.5, 3)
     spacing = (0.5, 0.25, 0.125)
-    surfaces = surftrack.label_surfaces(labels, spacing=spacing)
+    surfaces = surftrack.label_surfaces(labels, spacing=spacing, walls="independent")
     surftrack.write_precomputed(surfaces, tmp_path / "legacy", axes="zyx", unit="um", spacing=spacing)
     surftrack.write_precomputed(surfaces, tmp_path / "multi", axes="zyx", unit="um", spacing=spacing, lods=2)
     info = read_info(tmp_path / "multi")
@@ -365,7 +365,7 @@ def test_sharded_and_unsharded_hold_the_same_segments(tmp_path):
     rng = np.random.default_rng(4)
     labels = boxes_volume(rng, (14, 14, 14), list(range(1, 40)))
     labels[labels > 0] += np.uint64(2**40)
-    surfaces = surftrack.label_surfaces(labels)
+    surfaces = surftrack.label_surfaces(labels, walls="independent")
     surftrack.write_precomputed(surfaces, tmp_path / "u", axes="zyx", lods=2)
     read_info(tmp_path / "u")
     for hashing in (True, "identity"):
@@ -398,7 +398,7 @@ def test_many_labels_spread_over_minishards_by_the_hash(tmp_path):
     assert len(ids) == 343
     for n, (z, y, x) in enumerate(np.ndindex(7, 7, 7)):
         labels[3 * z:3 * z + 2, 3 * y:3 * y + 2, 3 * x:3 * x + 2] = ids[n]
-    surfaces = surftrack.label_surfaces(labels)
+    surfaces = surftrack.label_surfaces(labels, walls="independent")
     surftrack.write_precomputed(surfaces, tmp_path / "s", axes="zyx", lods=1, sharded=True)
     info = read_info(tmp_path / "s")
     assert info["sharding"]["minishard_bits"] + info["sharding"]["shard_bits"] >= 1
@@ -413,7 +413,7 @@ def test_many_labels_spread_over_minishards_by_the_hash(tmp_path):
 def test_bad_input_is_refused_and_nothing_written(tmp_path):
     labels = np.zeros((6, 6, 6), np.uint8)
     labels[1:4, 1:4, 1:4] = 3
-    surfaces = surftrack.label_surfaces(labels)
+    surfaces = surftrack.label_surfaces(labels, walls="independent")
     with pytest.raises(ValueError, match="positive uint64"):
         surftrack.write_precomputed({0: surfaces[3]}, tmp_path / "p", axes="zyx", lods=2)
     with pytest.raises(ValueError, match="lods"):
@@ -455,7 +455,7 @@ def test_cli_labels_and_mesh(tmp_path):
         t = np.asarray(info["transform"]).reshape(3, 4)
         # Voxel indices to nanometres: the spacing, and half a voxel (voxel i over [i, i + 1)).
         assert np.allclose(t[:, :3], np.diag([4, 5, 40])) and np.allclose(t[:, 3], [2, 2.5, 20])
-        surfaces = surftrack.label_surfaces(labels)  # index space, columns z, y, x
+        surfaces = surftrack.label_surfaces(labels, walls="independent")  # index space, columns z, y, x
         for segid, s in surfaces.items():
             m = load_segment(out, info, segid, tmp_path)
             check_segment(m, info, np.asarray(s.vertices, float)[:, ::-1], np.asarray(s.faces)[:, ::-1])

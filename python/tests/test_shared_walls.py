@@ -73,14 +73,26 @@ def test_walls_are_shared_and_space_is_partitioned(rng):
             assert np.array_equal(inside, (labels[tuple(centres.astype(int).T)] == label).astype(int)), (trial, label)
 
 
-def test_independent_stays_the_default(rng):
+def same_meshes(a, b):
+    assert sorted(a) == sorted(b)
+    return all(np.array_equal(a[k].vertices, b[k].vertices) and np.array_equal(a[k].faces, b[k].faces) for k in a)
+
+
+def test_shared_is_the_default_where_it_is_made(rng):
     labels = rng.integers(0, 4, size=(5, 4, 6)).astype(np.uint8)
-    default = surftrack.label_surfaces(labels, threads=1)
-    independent = surftrack.label_surfaces(labels, threads=1, walls="independent")
-    assert sorted(default) == sorted(independent)
-    for label in default:
-        assert np.array_equal(default[label].vertices, independent[label].vertices)
-        assert np.array_equal(default[label].faces, independent[label].faces)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        default = surftrack.label_surfaces(labels, threads=1)
+        independent = surftrack.label_surfaces(labels, threads=1, walls="independent")
+        assert same_meshes(default, shared(labels))
+        assert not same_meshes(default, independent)  # (this image has walls between labels)
+        assert same_meshes(surftrack.label_surfaces(labels, threads=1, adjacency="6-26"),
+                           shared(labels, adjacency="6-26"))
+        # Where shared walls are not made, the default is each label against the rest.
+        for kwargs in ({"boundaries": "largest"}, {"adjacency": "18-6"}, {"adjacency": "6-18"},
+                       {"seeds": [tuple(int(i) for i in np.argwhere(labels == 1)[0])]}):
+            assert same_meshes(surftrack.label_surfaces(labels, threads=1, **kwargs),
+                               surftrack.label_surfaces(labels, threads=1, walls="independent", **kwargs)), kwargs
 
 
 def test_bad_walls_and_refusals():
@@ -116,6 +128,26 @@ def test_cli_walls(tmp_path, rng):
     rows = {row["label"]: row for row in report["labels"]}
     for label, s in surfaces.items():
         assert rows[label]["triangles"] == len(s.faces), label
+    # Shared walls by default; independent where they are not made (--largest, 18-6).
+    for extra, walls in (([], "shared"), (["--largest"], "independent"), (["--adjacency", "18-6"], "independent")):
+        r = subprocess.run([cli(), "labels", "a.raw", *raw, "-o", "d.ply", "--json", "--threads", "1", *extra],
+                           cwd=tmp_path, capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        assert json.loads(r.stdout)["walls"] == walls, extra
+        assert r.stderr.count("\n") <= 1  # the pinches in one line at most
     r = subprocess.run([cli(), "labels", "a.raw", *raw, "-o", "all.ply", "--walls", "both"], cwd=tmp_path,
                        capture_output=True, text=True)
     assert r.returncode != 0 and "--walls" in r.stderr
+
+
+def test_the_same_meshes_on_1_2_7_threads(rng):
+    # The scan is one thread; the labels' meshes are finished in parallel, each the same for any
+    # count (pinch splits included: noisy images have many).
+    for trial in range(6):
+        labels = rng.integers(0, 9, size=tuple(int(n) for n in rng.integers(4, 12, size=3))).astype(np.uint16)
+        ref = shared(labels)
+        for threads in (2, 7):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                got = surftrack.label_surfaces(labels, walls="shared", threads=threads)
+            assert same_meshes(ref, got), (trial, threads)
