@@ -112,7 +112,7 @@ def test_cli_and_python_write_the_same_bytes(tmp_path):
                           "--format", "precomputed", "-o", str(cli_out) + "/", "--quiet"],
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    surfaces = surftrack.label_surfaces(labels, spacing=spacing_xyz[::-1], walls="independent")
+    surfaces = surftrack.label_surfaces(labels, spacing=spacing_xyz[::-1], walls="shared")
     py_out = tmp_path / "py"
     surftrack.write_precomputed(surfaces, py_out, axes="zyx", unit="nm", spacing=spacing_xyz[::-1])
     files = sorted(os.listdir(cli_out))
