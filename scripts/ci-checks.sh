@@ -6,16 +6,17 @@
 #                   per format for a bounded time, seeded with files written by ITK, zarr-python
 #                   and numcodecs (fuzz/run_fuzzers.sh; default 10 s per format; with
 #                   SURFTRACK_FUZZ_RUNS=N, N inputs from a fixed seed instead). CI runs this
-#                   with N = 2000 (.ci/run).
+#                   with N = 1000 (.ci/run).
 #   sanitize        the whole test suite again, in a build of its own with AddressSanitizer and
 #                   UndefinedBehaviorSanitizer's value checks on the engine
 #                   (-DSURFTRACK_SANITIZE=ON; CMakeLists.txt says which checks and where; any
-#                   report fails its test). CI runs it last (.ci/run); the CPU time of the build
-#                   and of the tests is printed (the machines are shared: wall-clock figures
-#                   depend on the others' load).
+#                   report fails its test). Run by hand before landing engine changes: it no
+#                   longer fits in CI's 30 minutes. The CPU time of the build and of the tests
+#                   is printed (the machines are shared: wall-clock figures depend on the
+#                   others' load).
 #   all [seconds]   both; the fuzzing, which runs one target at a time on one core, beside the
 #                   sanitized build (its log printed when both are done), then the sanitized
-#                   tests on a machine of their own. CI runs this (.ci/run).
+#                   tests on a machine of their own.
 #
 #   scripts/ci-checks.sh fuzz|sanitize|all [seconds per fuzz target]
 #
@@ -48,7 +49,7 @@ sanitize_build() {
   # lines. No benchmarks (nor the CGAL tool they use).
   # The engine and its tests only: without the Python module (about 100 CPU-s of compile and
   # 100 of tests) nor the command-line tool and the ITK readers (about 450 CPU-s of compile),
-  # for CI's 30 minutes. Those are tested by the main build's suite, and the volume-header and
+  # to keep it within a quarter of an hour. Those are tested by the main build's suite, and the volume-header and
   # chunked-store readers under both sanitizers by the fuzzing beside this build (fuzz/).
   cmake -S . -B build-sanitize -DSURFTRACK_SANITIZE=ON -DSURFTRACK_BUILD_BENCH=OFF -DSURFTRACK_BUILD_PYTHON=OFF \
         -DSURFTRACK_BUILD_CLI=OFF \
