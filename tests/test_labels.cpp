@@ -711,37 +711,43 @@ const char* const kAtlasDirectory = "/usr/share/mricron/templates";
 
 class Atlas : public ::testing::TestWithParam<const char*> {};
 
-TEST_P(Atlas, EveryLabelIsAClosedManifoldMeetingItsNeighboursExactly) {
-  const std::string path = std::string(kAtlasDirectory) + "/" + GetParam();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
-  const io::AnyVolume any = io::readVolume(path);
+/// f(image) on the atlas file's image, which must hold integer labels.
+template <class F>
+void onAtlasImage(const std::string& path, F&& f) {
   std::visit(
       [&](const auto& image) {
         using T = typename std::decay_t<decltype(image)>::value_type;
-        if constexpr (std::is_integral_v<T>) {
-          LabelVolume volume;
-          volume.dims = image.dims();
-          volume.labels.assign(image.data().begin(), image.data().end());
-          const VolumeView view = VolumeView::of(image.data().data(), image.dims(), image.geometry());
-          // Both pairs on the small atlases (2 mm voxels), the default pair on the 1 mm ones (each
-          // ctest under a minute on the 2-vCPU machine while other tests run).
-          for (AdjacencyPair pair : {AdjacencyPair::k26_6, AdjacencyPair::k6_26}) {
-            if (pair != AdjacencyPair::k26_6 && (volume.dims.count() > 2000000 || surftrack::testing::kSanitizedBuild))
-              continue;
-            SCOPED_TRACE(toString(pair));
-            LabelOptions options;
-            options.pair = pair;
-            const auto surfaces = extractLabels(view, options);
-            // The binary path scans the whole image per label: every 8th label.
-            CheckOptions checks;
-            checks.binaryPathEvery = 8;
-            checkLabelSurfaces(volume, view, 0, pair, surfaces, checks);
-          }
-        } else {
+        if constexpr (std::is_integral_v<T>)
+          f(image);
+        else
           FAIL() << path << " holds " << toString(scalarTypeOf<T>()) << " voxels, not labels";
-        }
       },
-      any);
+      io::readVolume(path));
+}
+
+TEST_P(Atlas, EveryLabelIsAClosedManifoldMeetingItsNeighboursExactly) {
+  const std::string path = std::string(kAtlasDirectory) + "/" + GetParam();
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
+  onAtlasImage(path, [&](const auto& image) {
+    LabelVolume volume;
+    volume.dims = image.dims();
+    volume.labels.assign(image.data().begin(), image.data().end());
+    const VolumeView view = VolumeView::of(image.data().data(), image.dims(), image.geometry());
+    // Both pairs on the small atlases (2 mm voxels), the default pair on the 1 mm ones (each
+    // ctest under a minute on the 2-vCPU machine while other tests run).
+    for (AdjacencyPair pair : {AdjacencyPair::k26_6, AdjacencyPair::k6_26}) {
+      if (pair != AdjacencyPair::k26_6 && (volume.dims.count() > 2000000 || surftrack::testing::kSanitizedBuild))
+        continue;
+      SCOPED_TRACE(toString(pair));
+      LabelOptions options;
+      options.pair = pair;
+      const auto surfaces = extractLabels(view, options);
+      // The binary path scans the whole image per label: every 8th label.
+      CheckOptions checks;
+      checks.binaryPathEvery = 8;
+      checkLabelSurfaces(volume, view, 0, pair, surfaces, checks);
+    }
+  });
 }
 
 // Shared walls (docs/theory.md §12) on the atlas: each triangle of a label has its reversed twin
@@ -752,72 +758,66 @@ TEST_P(Atlas, EveryLabelIsAClosedManifoldMeetingItsNeighboursExactly) {
 TEST_P(Atlas, SharedWallsAreTwinsAndEveryLabelIsAManifold) {
   const std::string path = std::string(kAtlasDirectory) + "/" + GetParam();
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (mricron-data)";
-  const io::AnyVolume any = io::readVolume(path);
-  std::visit(
-      [&](const auto& image) {
-        using T = typename std::decay_t<decltype(image)>::value_type;
-        if constexpr (std::is_integral_v<T>) {
-          const VolumeView view = VolumeView::of(image.data().data(), image.dims(), image.geometry());
-          const Dims dims = image.dims();
-          auto labelAt = [&](const Voxel& v) -> long long {  // outside the domain: the background
-            if (v.x < 0 || v.y < 0 || v.z < 0 || v.x >= dims.nx || v.y >= dims.ny || v.z >= dims.nz) return 0;
-            return (long long)image.data()[std::size_t(v.x + std::int64_t(dims.nx) * (v.y + std::int64_t(dims.ny) * v.z))];
-          };
-          LabelOptions options;
-          options.walls = LabelWalls::Shared;
-          const auto surfaces = extractLabels(view, options);
-          using Key = std::array<int, 3>;
-          using Tri = std::array<Key, 3>;
-          auto keyOf = [](const Surfel& s) {
-            const Voxel c = s.inside(), d = s.outside();
-            return Key{c.x + d.x, c.y + d.y, c.z + d.z};
-          };
-          auto directed = [](Tri t) {
-            std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
-            return t;
-          };
-          std::vector<std::pair<Tri, std::size_t>> owners;  // (directed triangle, label index)
-          std::size_t copies = 0, joined = 0, pinched = 0;
-          for (std::size_t l = 0; l < surfaces.size(); ++l) {
-            const LabelSurface& ls = surfaces[l];
-            const Surface& s = ls.surface;
-            SCOPED_TRACE("label " + ls.label.text());
-            EXPECT_EQ(ls.unsplitEdges, 0u);
-            const checks::Topology topology = checks::topologyOf(s.vertices.size(), s.triangles);
-            EXPECT_TRUE(topology.manifoldVertices) << topology.problem;
-            EXPECT_EQ(topology.euler, s.euler);
-            std::vector<Key> keys;
-            for (const Surfel& f : s.surfels) keys.push_back(keyOf(f));
-            for (const auto& t : s.triangles) owners.push_back({directed({keys[t[0]], keys[t[1]], keys[t[2]]}), l});
-            std::sort(keys.begin(), keys.end());
-            EXPECT_EQ(s.vertices.size() - std::size_t(std::unique(keys.begin(), keys.end()) - keys.begin()), ls.pinchCopies);
-            copies += ls.pinchCopies, joined += ls.joinedEdges, pinched += ls.pinchedEdges;
-          }
-          std::size_t twins = 0, onBackground = 0;
-          std::sort(owners.begin(), owners.end());
-          for (std::size_t i = 0; i < owners.size(); ++i) {
-            const auto& [t, label] = owners[i];
-            ASSERT_TRUE(i == 0 || owners[i - 1].first != t) << "a triangle twice the same way";
-            const Tri reverse = directed({t[0], t[2], t[1]});
-            const auto back = std::lower_bound(owners.begin(), owners.end(), std::pair<Tri, std::size_t>{reverse, 0});
-            if (back != owners.end() && back->first == reverse) {
-              ASSERT_NE(back->second, label) << "a triangle and its reverse in one label";
-              ++twins;
-              continue;
-            }
-            ++onBackground;
-            for (const Key& k : t) {  // the vertex's surfel: the voxels k / 2 and (k + 1) / 2
-              const Voxel c{k[0] >> 1, k[1] >> 1, k[2] >> 1}, d{(k[0] + 1) >> 1, (k[1] + 1) >> 1, (k[2] + 1) >> 1};
-              ASSERT_TRUE(labelAt(c) == 0 || labelAt(d) == 0) << "a triangle without its twin off the background";
-            }
-          }
-          EXPECT_GT(twins, 0u);
-          std::cout << "[ study ] " << GetParam() << ": " << surfaces.size() << " labels, " << twins
-                    << " wall triangles with their twin, " << onBackground << " on the background; " << pinched
-                    << " pinched edges (" << joined << " taken as joined), " << copies << " vertex copies\n";
-        }
-      },
-      any);
+  onAtlasImage(path, [&](const auto& image) {
+    const VolumeView view = VolumeView::of(image.data().data(), image.dims(), image.geometry());
+    const Dims dims = image.dims();
+    auto labelAt = [&](const Voxel& v) -> long long {  // outside the domain: the background
+      if (v.x < 0 || v.y < 0 || v.z < 0 || v.x >= dims.nx || v.y >= dims.ny || v.z >= dims.nz) return 0;
+      return (long long)image.data()[std::size_t(v.x + std::int64_t(dims.nx) * (v.y + std::int64_t(dims.ny) * v.z))];
+    };
+    LabelOptions options;
+    options.walls = LabelWalls::Shared;
+    const auto surfaces = extractLabels(view, options);
+    using Key = std::array<int, 3>;
+    using Tri = std::array<Key, 3>;
+    auto keyOf = [](const Surfel& s) {
+      const Voxel c = s.inside(), d = s.outside();
+      return Key{c.x + d.x, c.y + d.y, c.z + d.z};
+    };
+    auto directed = [](Tri t) {
+      std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+      return t;
+    };
+    std::vector<std::pair<Tri, std::size_t>> owners;  // (directed triangle, label index)
+    std::size_t copies = 0, joined = 0, pinched = 0;
+    for (std::size_t l = 0; l < surfaces.size(); ++l) {
+      const LabelSurface& ls = surfaces[l];
+      const Surface& s = ls.surface;
+      SCOPED_TRACE("label " + ls.label.text());
+      EXPECT_EQ(ls.unsplitEdges, 0u);
+      const checks::Topology topology = checks::topologyOf(s.vertices.size(), s.triangles);
+      EXPECT_TRUE(topology.manifoldVertices) << topology.problem;
+      EXPECT_EQ(topology.euler, s.euler);
+      std::vector<Key> keys;
+      for (const Surfel& f : s.surfels) keys.push_back(keyOf(f));
+      for (const auto& t : s.triangles) owners.push_back({directed({keys[t[0]], keys[t[1]], keys[t[2]]}), l});
+      std::sort(keys.begin(), keys.end());
+      EXPECT_EQ(s.vertices.size() - std::size_t(std::unique(keys.begin(), keys.end()) - keys.begin()), ls.pinchCopies);
+      copies += ls.pinchCopies, joined += ls.joinedEdges, pinched += ls.pinchedEdges;
+    }
+    std::size_t twins = 0, onBackground = 0;
+    std::sort(owners.begin(), owners.end());
+    for (std::size_t i = 0; i < owners.size(); ++i) {
+      const auto& [t, label] = owners[i];
+      ASSERT_TRUE(i == 0 || owners[i - 1].first != t) << "a triangle twice the same way";
+      const Tri reverse = directed({t[0], t[2], t[1]});
+      const auto back = std::lower_bound(owners.begin(), owners.end(), std::pair<Tri, std::size_t>{reverse, 0});
+      if (back != owners.end() && back->first == reverse) {
+        ASSERT_NE(back->second, label) << "a triangle and its reverse in one label";
+        ++twins;
+        continue;
+      }
+      ++onBackground;
+      for (const Key& k : t) {  // the vertex's surfel: the voxels k / 2 and (k + 1) / 2
+        const Voxel c{k[0] >> 1, k[1] >> 1, k[2] >> 1}, d{(k[0] + 1) >> 1, (k[1] + 1) >> 1, (k[2] + 1) >> 1};
+        ASSERT_TRUE(labelAt(c) == 0 || labelAt(d) == 0) << "a triangle without its twin off the background";
+      }
+    }
+    EXPECT_GT(twins, 0u);
+    std::cout << "[ study ] " << GetParam() << ": " << surfaces.size() << " labels, " << twins
+              << " wall triangles with their twin, " << onBackground << " on the background; " << pinched
+              << " pinched edges (" << joined << " taken as joined), " << copies << " vertex copies\n";
+  });
 }
 
 INSTANTIATE_TEST_SUITE_P(MricronData, Atlas,
