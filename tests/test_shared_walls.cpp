@@ -23,11 +23,13 @@
 #include <optional>
 #include <random>
 #include <set>
+#include <unordered_map>
 #include <vector>
 
 #include "CaseSubset.h"
 #include "ClosedManifold.h"
 #include "DigitalCube.h"
+#include "FlatKeyMap.h"
 #include "LabelPatterns.h"
 #include "Labels.h"
 #include "MeshChecks.h"
@@ -637,6 +639,29 @@ TEST(SharedWalls, Refusals) {
   options.seeds.clear();
   options.pair = AdjacencyPair::k18_6;
   EXPECT_THROW(extractLabels(VolumeView::of(data.data(), Dims{2, 2, 2}), options), InvalidInput);
+}
+
+}  // namespace
+}  // namespace surftrack
+
+namespace surftrack {
+namespace {
+
+/// lib/FlatKeyMap.h, which numbers the vertices of the shared walls' scan, against
+/// std::unordered_map on random keys with repeats (the table grows many times).
+TEST(FlatKeyMap, AgreesWithAnUnorderedMap) {
+  std::mt19937_64 rng(7);
+  for (const std::uint64_t range : {std::uint64_t(50), std::uint64_t(1) << 20, ~std::uint64_t(0) - 1}) {
+    FlatKeyMap flat;
+    std::unordered_map<std::uint64_t, std::uint32_t> reference;
+    std::uniform_int_distribution<std::uint64_t> key(0, range);
+    for (std::uint32_t i = 0; i < 200000; ++i) {
+      const std::uint64_t k = key(rng);
+      const auto [it, added] = reference.try_emplace(k, i);
+      ASSERT_EQ(flat.tryEmplace(k, i), std::make_pair(it->second, added)) << "key " << k;
+    }
+    ASSERT_EQ(flat.size(), reference.size());
+  }
 }
 
 }  // namespace

@@ -31,6 +31,7 @@
 #include "BoundaryMapping.h"
 #include "ComplexSmoothing.h"
 #include "DigitalCube.h"
+#include "FlatKeyMap.h"
 #include "Image.h"
 #include "Labels.h"
 #include "NestedWalls.h"
@@ -79,7 +80,7 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
 
   // 2. Each selected label's mesh, in grid edges.
   struct Building {
-    std::unordered_map<std::uint64_t, std::uint32_t> vertexOf;  // grid edge key -> vertex
+    FlatKeyMap vertexOf;  // grid edge key -> vertex
     std::vector<Surfel> surfels;
     std::vector<std::array<std::uint32_t, 3>> triangles;
     std::vector<std::uint32_t> complexVertex;  // with smoothing or decimation: each vertex's in the complex
@@ -93,7 +94,7 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
   const bool smoothing = o.smooth.has_value(), decimating = o.decimate.has_value();
   const bool keepComplex = smoothing || decimating;
   struct Complex {
-    std::unordered_map<std::uint64_t, std::uint32_t> vertexOf;
+    FlatKeyMap vertexOf;
     std::vector<Surfel> surfels;
     std::vector<std::array<std::uint32_t, 3>> triangles;
     std::vector<std::array<std::uint32_t, 2>> sides;  // each triangle's (inside, outside) priorities
@@ -101,16 +102,16 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
   // The vertex of cube m's edge in a vertex map keyed by grid edge, and whether it is new; a new
   // one gets its surfel from its low voxel where fromLow(priority low, priority high) says so,
   // else from its high voxel.
-  auto vertexOfEdge = [&](std::unordered_map<std::uint64_t, std::uint32_t>& vertexOf, std::vector<Surfel>& surfels,
+  auto vertexOfEdge = [&](FlatKeyMap& vertexOf, std::vector<Surfel>& surfels,
                           const Voxel& m, int edge, auto&& fromLow) {
     const Voxel lo = m + cube::cornerOffset(cube::edgeLowCorner(edge));
     const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
     const int axis = cube::edgeAxis(edge);
-    const auto [it, added] = vertexOf.try_emplace(Surfel{lo, directionOf(axis, +1)}.key(), std::uint32_t(surfels.size()));
+    const auto [v, added] = vertexOf.tryEmplace(Surfel{lo, directionOf(axis, +1)}.key(), std::uint32_t(surfels.size()));
     if (added)
       surfels.push_back(fromLow(priorityAt(lo), priorityAt(hi)) ? Surfel{lo, directionOf(axis, +1)}
                                                                 : Surfel{hi, directionOf(axis, -1)});
-    return std::pair<std::uint32_t, bool>{it->second, added};
+    return std::pair<std::uint32_t, bool>{v, added};
   };
   auto complexVertex = [&](const Voxel& m, int edge) {
     return vertexOfEdge(complex.vertexOf, complex.surfels, m, edge,
@@ -209,7 +210,7 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     const std::size_t k = order[at];
     if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
     Building& b = building[k];
-    std::unordered_map<std::uint64_t, std::uint32_t>().swap(b.vertexOf);  // done with it
+    b.vertexOf.clear();  // done with it
     std::vector<std::array<double, 3>> doubled(b.surfels.size());  // exact: 2 x the midpoint
     for (std::size_t v = 0; v < b.surfels.size(); ++v) {
       const Voxel c = b.surfels[v].inside(), d = b.surfels[v].outside();
