@@ -95,7 +95,7 @@ PYTHON_SINGLE = r'''
 import sys, numpy as np, surftrack
 raw, n, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 labels = np.memmap(raw, dtype="<u4", mode="r", shape=(n, n, n))
-for label, surface in surftrack.label_surfaces(labels, threads=0).items():
+for label, surface in surftrack.label_surfaces(labels, threads=0, walls="independent").items():
     surface.write(f"{out}/label_{label}.ply")
 '''
 
@@ -130,7 +130,7 @@ def main():
     shutil.rmtree(single, ignore_errors=True)
     os.makedirs(single)
     subprocess.run(["cat", raw], stdout=subprocess.DEVNULL, check=True)  # page-cached
-    wall, rss = timed([cli, "labels", raw, "--raw-dims", f"{n},{n},{n}", "--raw-type", "uint32",
+    wall, rss = timed([cli, "labels", "--walls", "independent", raw, "--raw-dims", f"{n},{n},{n}", "--raw-type", "uint32",
                        "-o", os.path.join(single, "label_{label}.ply"), "-q"])
     count = len(os.listdir(single))
     if count != args.cells:
@@ -141,7 +141,7 @@ def main():
     other = os.path.join(args.dir, "single-store")
     shutil.rmtree(other, ignore_errors=True)
     os.makedirs(other)
-    wall, rss = timed([cli, "labels", store, "-o", os.path.join(other, "label_{label}.ply"), "-q"])
+    wall, rss = timed([cli, "labels", "--walls", "independent", store, "-o", os.path.join(other, "label_{label}.ply"), "-q"])
     if not same_files(single, other):
         sys.exit("bench_distributed: the single pass from the store differs from the raw file's")
     print(f"single pass, store decoded whole, 2 threads: {wall:.1f} s, peak RSS {rss:.0f} MiB", flush=True)

@@ -2,7 +2,7 @@
 """Label maps (docs/performance.md, "Label maps"): every label of a label image in one call.
 
 (a) Every label of the AAL atlas (mricron-data's aal.nii.gz, 116 labels, background 0), all
-    boundaries: surftrack.label_surfaces(labels, threads=N) against VTK's
+    boundaries: surftrack.label_surfaces(labels, threads=N, walls="independent") against VTK's
     vtkDiscreteFlyingEdges3D with the 116 label values (SetValue(i, L); no normals, gradients
     or scalars computed), VTK on the same N threads (SMP backend Sequential for N = 1, else its
     default backend initialised with N). Both in this process, one after the other, medians of
@@ -110,7 +110,7 @@ def part_aal(args) -> None:
     vtk = DiscreteFlyingEdges(args.threads)
     print(vtk.description)
     # Check once, untimed.
-    surfaces = surftrack.label_surfaces(labels, threads=args.threads)
+    surfaces = surftrack.label_surfaces(labels, threads=args.threads, walls="independent")
     assert sorted(surfaces) == values, "one surface per label"
     for L in values[::10]:
         assert len(surfaces[L].vertices) == direct_surfels(labels, L), L
@@ -119,7 +119,7 @@ def part_aal(args) -> None:
     ours = sum(len(s.vertices) for s in surfaces.values())
     ours_tri = sum(len(s.faces) for s in surfaces.values())
     del surfaces
-    t_ours, _ = timed(lambda: surftrack.label_surfaces(labels, threads=args.threads), args.repeat)
+    t_ours, _ = timed(lambda: surftrack.label_surfaces(labels, threads=args.threads, walls="independent"), args.repeat)
     load_mid = os.getloadavg()[0]
     t_vtk, _ = timed(lambda: vtk(labels, values), args.repeat)
     a, b = statistics.median(t_ours), statistics.median(t_vtk)
@@ -158,7 +158,7 @@ def voronoi_worker(path: str, threads: int, repeat: int) -> None:
     times, vertices, faces, labels = [], 0, 0, 0
     for _ in range(repeat):
         t0 = time.perf_counter()
-        surfaces = surftrack.label_surfaces(volume, threads=threads)
+        surfaces = surftrack.label_surfaces(volume, threads=threads, walls="independent")
         times.append(time.perf_counter() - t0)
         vertices = sum(len(s.vertices) for s in surfaces.values())
         faces = sum(len(s.faces) for s in surfaces.values())
@@ -232,7 +232,7 @@ def part_interfaces(args) -> None:
         if not os.path.exists(path):
             continue
         labels = load_labels(path)
-        surfaces = surftrack.label_surfaces(labels, threads=args.threads)
+        surfaces = surftrack.label_surfaces(labels, threads=args.threads, walls="independent")
         # Vertices by surfel midpoint (exact: the midpoint mapping, no geometry), a global id each.
         allv = np.concatenate([s.vertices for s in surfaces.values()])
         _, ids = np.unique(allv, axis=0, return_inverse=True)
