@@ -28,6 +28,7 @@ struct ComplexDecimationReport {
   std::size_t targetTriangles = 0;  ///< the walls' targets summed (0: no target)
   std::size_t walls = 0;            ///< walls of the complex
   std::size_t lockedVertices = 0;   ///< vertices on junction lines or pinches
+  std::size_t junctionCollapses = 0;  ///< vertices gone from inside junction lines (JunctionLines.h)
 };
 
 /// Decimates the complex of `triangles` over `points` (physical) in place: triangle t lies on

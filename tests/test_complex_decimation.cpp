@@ -12,8 +12,8 @@
 //    complex meet other than in what they share (CGAL on the soup of the complex);
 //  - each label within max error of its undecimated self both ways (CGAL's sampled distance);
 //  - the figures: triangles before and after, volumes as the meshes give them;
-//  - with a reduction alone on the blown-up patterns, how near the triangles come to the
-//    target (printed; the total within 5 %).
+//  - with a reduction alone on the blown-up patterns, the labels' triangles within 5 % of the
+//    target (the total over the patterns).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -251,12 +251,14 @@ auto priorities(const std::vector<std::uint16_t>& data, Dims dims, bool withBack
 TEST(ComplexDecimation, RandomLabelImages) {
   std::mt19937_64 rng(5151);
   Stats stats;
-  for (int image = 0; image < 80; ++image) {
+  for (int image = 0; image < 1000; ++image) {
     std::uniform_int_distribution<int> side(2, 5);
     const Dims dims{side(rng), side(rng), side(rng)};
     const int count = std::uniform_int_distribution<int>(2, image % 4 == 0 ? 40 : 6)(rng);
     const bool withBackground = image % 2 == 0;
-    const std::vector<std::uint16_t> data = testing::randomLabels(rng, dims, count, withBackground);
+    std::vector<std::uint16_t> data;
+    do data = testing::randomLabels(rng, dims, count, withBackground);  // (a label at least)
+    while (std::all_of(data.begin(), data.end(), [&](std::uint16_t x) { return withBackground && x == 0; }));
     if (!caseChecked(std::uint64_t(image))) continue;
     DecimateOptions decimate;
     if (image % 3 != 1) decimate.maxError = 0.3 + 0.1 * (image % 4);
@@ -266,7 +268,7 @@ TEST(ComplexDecimation, RandomLabelImages) {
                     priorities(data, dims, withBackground), "image " + std::to_string(image), stats);
     if (::testing::Test::HasFatalFailure()) return;
   }
-  EXPECT_GE(stats.images, testing::subsetMinimum(80));
+  EXPECT_GE(stats.images, testing::subsetMinimum(1000));
   EXPECT_LT(stats.after, stats.before);
   std::cout << "[ study ] " << stats.images << " random images, " << stats.labels << " labels: triangles "
             << stats.before << " -> " << stats.after << "\n";
@@ -308,13 +310,12 @@ TEST(ComplexDecimation, BlownUpCubePatterns) {
   std::cout << "[ study ] " << checked << " blown-up cube patterns, reduce 0.8: triangles " << reduced.before << " -> "
             << reduced.after << " (labels' target " << reduced.target << "); the complex " << reduced.complexBefore
             << " -> " << reduced.complexAfter << " (" << reduced.reachable
-            << " if each wall reached its target or lost every free vertex, creases aside); max error 0.3: "
+            << " if each wall reached its target or lost every free vertex, the junction lines kept); max error 0.3: "
             << bounded.before << " -> " << bounded.after << "\n";
-  // The reduction is far from its target here: the junction lines' vertices stay, the normal
-  // guard keeps the creases of the walls on the outside, and a chord between two junction
-  // vertices that one wall takes is refused to the next (the link condition over the complex).
-  // Measured, not bounded (docs/theory.md §12, "Decimating the complex", limits).
-  EXPECT_LT(double(reduced.complexAfter), 0.8 * double(reduced.complexBefore));
+  // The target of the labels' triangles within 5 %: the walls decimated, then the junction lines
+  // and the walls again (docs/theory.md §12, "Decimating the complex").
+  EXPECT_LE(double(reduced.after), 1.05 * double(reduced.target));
+  EXPECT_GE(double(reduced.after), 0.95 * double(reduced.target));
 }
 
 TEST(ComplexDecimation, LabelsOnTheBackgroundReachTheTarget) {
