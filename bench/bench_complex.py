@@ -663,7 +663,10 @@ def main():
                     help="the atlas labels of the picture (default 71,73,75,77: AAL's left caudate, putamen, "
                          "pallidum, thalamus; when one is missing, 5 touching labels are chosen)")
     ap.add_argument("--points", type=int, default=3000, help="random points per input (default 3000)")
+    ap.add_argument("--tables", default="1,2,3,4",
+                    help="which tables to make (default 1,2,3,4; 4 brings the picture, 5)")
     a = ap.parse_args()
+    tables = {int(n) for n in a.tables.split(",") if n.strip()}
     started = time.perf_counter()
     print(f"# bench_complex: surftrack {surftrack.__version__}, threads {a.threads}, "
           f"load average at start {os.getloadavg()[0]:.2f}{' (quick run)' if a.quick else ''}\n")
@@ -697,55 +700,58 @@ def main():
     if aal is not None:
         inputs.append((f"AAL{' (48³ crop)' if a.quick else ''}, points near labels {group}", aal, group))
     rows = []
-    for seed, (name, labels, subset) in enumerate(inputs):
+    for seed, (name, labels, subset) in enumerate(inputs if 1 in tables else []):
         # AAL's labels are large (about 12,000 triangles each): a third of the points, for time.
         p = sample_points(labels, 0, points if subset is None else points // 3, 100 + seed, subset)
         for walls in ("independent", "shared"):
             rows.append(stress_row(name, labels, walls, 0, a.threads, p))
     out["stress"] = rows
-    print("## 1. Stress inputs: walls shared between labels, space partitioned, defects (26-6)\n")
-    print(table(rows, [("input", "input", None), ("walls", "walls", None), ("labels", "labels", "d"),
-                       ("triangles", "triangles", ",d"), ("twins %", "twin_pct", ".2f"),
-                       ("points", "points", "d"), ("right %", "points_right_pct", ".2f"),
-                       ("overlaps", "overlaps", "d"), ("gaps", "gaps", "d"),
-                       ("labels with edges of >2 triangles", "labels_multi_edges", "d"),
-                       ("such edges", "multi_edges", "d"), ("boundary edges", "boundary_edges", "d"),
-                       ("labels with coincident vertices", "labels_coincident", "d"),
-                       ("coincident vertices", "coincident_vertices", "d")]))
-    print("\ntwins %: of the triangles not on the background's wall, those whose reversed twin is in another "
-          "label. right %: random points in cells of 2+ labels inside exactly one label (at most one where the "
-          "cell has a background corner); overlaps: inside 2+; gaps: inside none where one is required.\n")
+    if 1 in tables:
+        print("## 1. Stress inputs: walls shared between labels, space partitioned, defects (26-6)\n")
+        print(table(rows, [("input", "input", None), ("walls", "walls", None), ("labels", "labels", "d"),
+                           ("triangles", "triangles", ",d"), ("twins %", "twin_pct", ".2f"),
+                           ("points", "points", "d"), ("right %", "points_right_pct", ".2f"),
+                           ("overlaps", "overlaps", "d"), ("gaps", "gaps", "d"),
+                           ("labels with edges of >2 triangles", "labels_multi_edges", "d"),
+                           ("such edges", "multi_edges", "d"), ("boundary edges", "boundary_edges", "d"),
+                           ("labels with coincident vertices", "labels_coincident", "d"),
+                           ("coincident vertices", "coincident_vertices", "d")]))
+        print("\ntwins %: of the triangles not on the background's wall, those whose reversed twin is in another "
+              "label. right %: random points in cells of 2+ labels inside exactly one label (at most one where the "
+              "cell has a background corner); overlaps: inside 2+; gaps: inside none where one is required.\n")
 
     # 2. Shared walls after decimation.
-    print("## 2. Shared wall triangles after decimation: the complex against each label alone (VTK)\n")
-    drows = []
-    reductions = (0.5, 0.8, 0.9)
-    if aal is not None:
-        drows += decimation_rows("AAL" + (" (48³ crop)" if a.quick else ""), aal, a.threads, reductions)
-    drows += decimation_rows(inputs[0][0], inputs[0][1], a.threads, reductions)
-    out["decimation"] = drows
-    print(table(drows, [("input", "input", None), ("reduce", "reduce", ".1f"),
-                        ("triangles before", "triangles_before", ",d"), ("shared % before", "shared_pct_before", ".1f"),
-                        ("target", "target", ",d"), ("complex: triangles", "complex_triangles", ",d"),
-                        ("complex: shared %", "complex_shared_pct", ".1f"), ("VTK quadric per label: triangles",
-                                                                              "vtk_triangles", ",d"),
-                        ("VTK: shared %", "vtk_shared_pct", ".1f")]))
-    print("\nshared %: triangles whose reversed twin is in another label, over all the labels' triangles (the rest "
-          "face the background or the domain's border). surftrack's own decimation of one label alone is not "
-          "shown: surftrack has no decimation of a mesh it did not extract (no Surface method; extract(reduce=) "
-          "and `surftrack mesh --reduce` decimate the surface they extract, the CLI reads volumes only).\n")
+    if 2 in tables:
+        print("## 2. Shared wall triangles after decimation: the complex against each label alone (VTK)\n")
+        drows = []
+        reductions = (0.5, 0.8, 0.9)
+        if aal is not None:
+            drows += decimation_rows("AAL" + (" (48³ crop)" if a.quick else ""), aal, a.threads, reductions)
+        drows += decimation_rows(inputs[0][0], inputs[0][1], a.threads, reductions)
+        out["decimation"] = drows
+        print(table(drows, [("input", "input", None), ("reduce", "reduce", ".1f"),
+                            ("triangles before", "triangles_before", ",d"), ("shared % before", "shared_pct_before", ".1f"),
+                            ("target", "target", ",d"), ("complex: triangles", "complex_triangles", ",d"),
+                            ("complex: shared %", "complex_shared_pct", ".1f"), ("VTK quadric per label: triangles",
+                                                                                  "vtk_triangles", ",d"),
+                            ("VTK: shared %", "vtk_shared_pct", ".1f")]))
+        print("\nshared %: triangles whose reversed twin is in another label, over all the labels' triangles (the rest "
+              "face the background or the domain's border). surftrack's own decimation of one label alone is not "
+              "shown: surftrack has no decimation of a mesh it did not extract (no Surface method; extract(reduce=) "
+              "and `surftrack mesh --reduce` decimate the surface they extract, the CLI reads volumes only).\n")
 
     # 3. Accuracy.
-    print("## 3. Accuracy against the analytic shapes (relative errors; normal error: mean angle, degrees)\n")
-    arows = accuracy_rows(a.quick, a.threads)
-    out["accuracy"] = arows
-    print(table(arows, [("shape", "shape", None), ("mesh", "method", None), ("triangles", "triangles", ",d"),
-                        ("area %", "area_error_pct", "+.2f"), ("volume %", "volume_error_pct", "+.2f"),
-                        ("normal error °", "normal_error_deg", ".2f")]))
-    print("\nThe tube's normals are measured on the triangles at least 4 voxels from its caps.\n")
+    if 3 in tables:
+        print("## 3. Accuracy against the analytic shapes (relative errors; normal error: mean angle, degrees)\n")
+        arows = accuracy_rows(a.quick, a.threads)
+        out["accuracy"] = arows
+        print(table(arows, [("shape", "shape", None), ("mesh", "method", None), ("triangles", "triangles", ",d"),
+                            ("area %", "area_error_pct", "+.2f"), ("volume %", "volume_error_pct", "+.2f"),
+                            ("normal error °", "normal_error_deg", ".2f")]))
+        print("\nThe tube's normals are measured on the triangles at least 4 voxels from its caps.\n")
 
     # 4. The whole atlas, timed; 5. the picture.
-    if aal is not None:
+    if aal is not None and 4 in tables:
         with tempfile.TemporaryDirectory(prefix="bench_complex.") as work:
             t = aal_timing(aal, a.cli, None if a.quick else a.aal, a.threads, work)
         out["aal_time"] = t

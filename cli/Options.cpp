@@ -17,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "Labels.h"  // defaultLabelWalls
 #include "Refine.h"  // kMaxSmoothIterations
 
 namespace surftrack::cli {
@@ -823,13 +824,13 @@ void defineLabels(CLI::App& app, LabelsOptions& o, LabelsArgs& args) {
   addValue(
       app, "--max-error", "E", [&o](const std::string& s) { o.maxError = *toNumber(s); },
       "with --walls shared: decimate the complex, each wall once, within E\n(physical units) of the "
-      "undecimated walls; walls still shared, junction\nlines and each label's topology kept")
+      "undecimated walls; walls and junction lines still shared,\neach label's topology kept")
       ->check(explained(CLI::PositiveNumber, "--max-error takes a positive distance"))
       ->group(which);
   addValue(
       app, "--reduce", "F", [&o](const std::string& s) { o.reduction = *toNumber(s); },
       "with --walls shared: decimate the complex, removing the fraction F in\n[0, 1) of each wall's "
-      "triangles (as far as --max-error, the junction\nlines and the topology allow)")
+      "triangles (as far as --max-error and the topology allow)")
       ->check(explained(CLI::Range(0.0, 0.999999), [](const std::string& s) {
         return "--reduce takes a fraction in [0, 1), got '" + s + "'";
       }))
@@ -955,11 +956,11 @@ LabelsOptions parseLabelsOptions(const std::vector<std::string>& args) {
   if (o.smoothIterations > 0 && !o.dask.empty()) throw UsageError("--smooth is not made by blocks: no --dask");
   if ((o.maxError || o.reduction) && !o.dask.empty())
     throw UsageError("--max-error and --reduce are not made by blocks: no --dask");
-  // Shared walls (docs/theory.md §12) are the default wherever they are made: the whole image in
-  // one pass, every boundary, the pairs whose levels are one convex hull per cube.
-  const bool sharedMade = o.dask.empty() && !o.largest && o.seeds.empty() &&
-                          (o.pair == AdjacencyPair::k26_6 || o.pair == AdjacencyPair::k6_26);
-  if (o.walls.empty()) o.walls = sharedMade || o.smoothIterations > 0 || o.maxError || o.reduction ? "shared" : "independent";
+  if (o.walls.empty())
+    o.walls = defaultLabelWalls(o.dask.empty() && !o.largest && o.seeds.empty(), o.pair,
+                                o.smoothIterations > 0 || o.maxError || o.reduction) == LabelWalls::Shared
+                  ? "shared"
+                  : "independent";
   if (o.smoothIterations > 0 && o.walls != "shared")
     throw UsageError("--smooth on labels needs --walls shared: each label smoothed on its own would pull the "
                      "vertices it shares with its neighbours apart");

@@ -5,12 +5,14 @@
 // are not one closed disc around it (a pinch), is locked. Each wall, a surface with boundary
 // whose border vertices are all locked, is decimated once, one after the other, by
 // decimateSafely's engine (CheckedDecimater.h with the quadric, the normal-flip guard, the link
-// condition, the embedding guard and the sampled distance, TopologySafeDecimation.h), with two
+// condition, the embedding guard and the distance bound, TopologySafeDecimation.h), with two
 // more demands: the link condition and the embedding hold in the whole complex
-// (ComplexLinkGuard.h, EmbeddingGuard.h's obstacles), and only free vertices go. A halfedge
-// collapse moves no vertex, and a wall's decimated triangles replace its own: written to both
-// regions (reversed for one), the walls stay shared triangle for triangle, the junction lines
-// keep their vertices and edges, and every region's surface keeps its topology.
+// (ComplexLinkGuard.h, EmbeddingGuard.h's obstacles), and only free vertices go. Then the
+// vertices inside junction lines go along them, in every wall at once (JunctionLines.h), and
+// the walls again. A halfedge collapse moves no vertex, and a wall's decimated triangles replace
+// its own: written to both regions (reversed for one), the walls stay shared triangle for
+// triangle, the junction lines are the same in every wall along them, and every region's
+// surface keeps its topology.
 #pragma once
 
 #include <array>
@@ -36,8 +38,9 @@ struct ComplexDecimationReport {
 /// wall are oriented alike); on return removed[t] says whether triangle t is gone, and
 /// triangles[t] holds a survivor's vertices (a removed vertex replaced by the one it went into;
 /// the orientation kept). The walls are decimated in rounds, each wall a part of the way to its
-/// target in each (see ComplexDecimation.cpp). parameters.grid is not used; a reduction applies
-/// to each wall, as far as its locked vertices and the guards allow.
+/// target in each, then the junction lines (see ComplexDecimation.cpp). parameters.grid is not
+/// used; a reduction applies to each wall and each region (its walls' targets summed), as far
+/// as the guards allow.
 /// \throw std::invalid_argument for parameters out of range (decimateSafely's), sizes that
 ///        differ or a vertex index out of range; Cancelled when parameters.cancel is raised.
 ComplexDecimationReport decimateComplex(const std::vector<Point3>& points,

@@ -291,6 +291,11 @@ std::vector<LabelSurface> extractTyped(const VolumeView& view, const VoxelSource
 
 }  // namespace
 
+LabelWalls defaultLabelWalls(bool everyBoundaryInOnePass, AdjacencyPair pair, bool refined) {
+  const bool made = everyBoundaryInOnePass && (pair == AdjacencyPair::k26_6 || pair == AdjacencyPair::k6_26);
+  return made || refined ? LabelWalls::Shared : LabelWalls::Independent;
+}
+
 std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options) {
   if (!isInteger(view.type))
     throw InvalidInput("a label image needs integer voxels: this one has " + toString(view.type) + " voxels");

@@ -1011,6 +1011,14 @@ PYBIND11_MODULE(_surftrack, m) {
   m.def("store_layout", &storeLayout);
   m.def("read_store_box", &readStoreBox);
   m.def("label_surfaces_array", &labelSurfacesArray);
+  m.def(
+      "default_label_walls",
+      [](bool everyBoundaryInOnePass, const std::string& adjacency, bool refined) -> std::string {
+        return defaultLabelWalls(everyBoundaryInOnePass, parseAdjacencyPair(adjacency), refined) == LabelWalls::Shared
+                   ? "shared"
+                   : "independent";
+      },
+      "The walls label_surfaces gets when none are asked (docs/theory.md §12).");
   m.def("write_arrays", &writeArrays);
   m.def("write_component_arrays", &writeComponentArrays);
   m.def("write_precomputed", &writePrecomputed);

@@ -437,9 +437,9 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
     partitioned and each label keeps its voxels and topology (docs/theory.md §12, "Smoothing the
     complex"; each Surface's ``refine`` holds its volume before and after and its largest move).
     ``max_error`` (physical units) and/or ``reduce`` (the fraction of each wall's triangles to
-    remove; shared walls only) then decimate the complex, each wall once, its junction lines and
-    pinches kept: the walls stay shared triangle for triangle and each label keeps its components
-    and genus, within ``max_error`` of the undecimated walls (docs/theory.md §12, "Decimating the
+    remove; shared walls only) then decimate the complex, each wall once, then its junction lines
+    in all their walls at once: the walls stay shared triangle for triangle and each label keeps
+    its components and genus, within ``max_error`` of the undecimated walls (docs/theory.md §12, "Decimating the
     complex"; ``refine`` then also holds the triangles before and after and the target).
     Raises ValueError (surftrack.InvalidInput) / TypeError on bad input.
     """
@@ -458,8 +458,8 @@ def label_surfaces(labels, *, only: Optional[Sequence[int]] = None, label_range=
         raise ValueError(f"unsupported adjacency pair '{adjacency}': expected one of "
                          + ", ".join(_ADJACENCIES))
     if walls is None:  # shared walls wherever they are made (docs/theory.md §12)
-        made = boundaries == "all" and seeds is None and adjacency in ("26-6", "6-26")
-        walls = "shared" if made or smooth or max_error is not None or reduce is not None else "independent"
+        walls = _surftrack.default_label_walls(boundaries == "all" and seeds is None, adjacency,
+                                               bool(smooth or max_error is not None or reduce is not None))
     if walls not in ("independent", "shared"):
         raise ValueError(f"unknown walls '{walls}': expected 'independent' or 'shared'")
     if isinstance(smooth, bool) or int(smooth) != smooth or smooth < 0:

@@ -91,11 +91,12 @@ struct LabelOptions {
   /// Shared walls only: if set (a maxError, a reduction or both), the decimation of the complex,
   /// after the smoothing if both are asked (docs/theory.md §12, "Decimating the complex"): each
   /// wall (the triangles between one pair of labels, the background included) decimated once by
-  /// decimate()'s halfedge collapses and guards, its vertices on junction lines and pinches
-  /// kept, the link condition and the embedding checked over the whole complex; the wall's
-  /// triangles then go to both its labels, so that the walls stay shared triangle for triangle
-  /// and each label keeps its components and genus; each wall within maxError of its undecimated
-  /// self, both ways. The reduction applies to each wall, as far as its locked vertices allow.
+  /// decimate()'s halfedge collapses and guards, its junction lines and pinches locked, the link
+  /// condition and the embedding checked over the whole complex; then the junction lines, each
+  /// collapse along one done in all its walls at once; the triangles then go to both their
+  /// labels, so that the walls stay shared triangle for triangle and each label keeps its
+  /// components and genus; each wall within maxError of its undecimated self, both ways, for
+  /// every point. The reduction applies to each wall and each label, as far as the guards allow.
   /// With independent walls: refused (InvalidInput), as smooth.
   std::optional<DecimateOptions> decimate;
   /// Threads for the scan and for the labels: 0 for all cores. The surfaces are the same for any
@@ -140,6 +141,13 @@ struct LabelSurface {
 /// \throw Cancelled when options.cancel is raised.
 /// \throw InternalError when an engine invariant fails (a bug).
 std::vector<LabelSurface> extractLabels(const VolumeView& view, const LabelOptions& options);
+
+/// The walls a label map gets when its caller asks for none (the CLI's `labels`, the binding's
+/// label_surfaces; docs/theory.md §12): shared wherever they are made — every boundary of every
+/// label, the whole image in one pass (not by blocks), with a pair of 26-6 or 6-26 — or where a
+/// smoothing or a decimation (`refined`) needs them; independent elsewhere. LabelOptions keeps
+/// Independent as its own default, for the C++ callers that name what they want.
+LabelWalls defaultLabelWalls(bool everyBoundaryInOnePass, AdjacencyPair pair, bool refined);
 
 /// One label's part of the mesh of one block of a volume (docs/api.md, "Label maps by
 /// blocks"; docs/theory.md, "Label maps by blocks"): the triangles of the cubes the block owns.
