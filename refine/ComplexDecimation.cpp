@@ -16,7 +16,7 @@
 #include "CheckedDecimater.h"
 #include "ComplexLinkGuard.h"
 #include "DecimatedComplex.h"
-#include "DistanceGuard.h"
+#include "ProvenDistanceGuard.h"
 #include "EmbeddingGuard.h"
 #include "JunctionLines.h"
 #include "MeshTriangles.h"
@@ -114,7 +114,7 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
     std::vector<std::uint32_t> triangleOfFace;  // face index -> triangle
     std::unique_ptr<CheckedDecimaterT<Mesh>> decimater;
     OpenMesh::Decimater::ModQuadricT<Mesh>::Handle quadric;
-    ModSampledDistanceT<Mesh>::Handle distance;
+    ModProvenDistanceT<Mesh>::Handle distance;
     OpenMesh::Decimater::ModNormalFlippingT<Mesh>::Handle flipping;
     ModTopologyGuardT<Mesh>::Handle topology;
     ModEmbeddingGuardT<Mesh>::Handle embedding;
@@ -368,7 +368,7 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
     }
   }
   // With a distance bound, each triangle is at first its own piece of the original surface
-  // (DistanceGuard.h).
+  // (ProvenDistanceGuard.h).
   if (p.maxError) {
     c.original.resize(triangles.size());
     c.pieces.resize(triangles.size());

@@ -4,7 +4,7 @@
 // sides[t][1]; a collapse removes triangles (removed[t]) and renames a vertex in others
 // (triangles[t]), never moving a point. With a distance bound, every triangle keeps the
 // coordinates it had at the start (`original`, the surface each wall is measured against) and
-// the pieces of the original wall it answers for (`pieces`, DistanceGuard.h's, handed on from
+// the pieces of the original wall it answers for (`pieces`, ProvenDistanceGuard.h's, handed on from
 // collapse to collapse and from one kind of collapse to the other), so that the bound holds for
 // the whole decimation and not for each pass alone.
 #pragma once

@@ -1,13 +1,11 @@
 // A Decimater module (OpenMesh) that keeps the decimated surface within `tolerance` of the
-// original one, both ways, for every point (docs/theory.md, section 10), proven by
-// TriangleCover.h's cuts rather than sampled:
-//  - original -> decimated: the original surface is cut into *pieces*, each assigned to a
-//    current triangle that it lies within the tolerance of, whole (at the start, every face is
-//    its own piece); a collapse must find such a triangle, among those it creates or the others
-//    nearby, for every piece of the triangles it removes or replaces (cutting a piece in four
-//    where no one triangle takes it whole);
-//  - decimated -> original: every triangle a collapse creates lies within the tolerance of the
-//    original triangles, whole.
+// original one, both ways, on samples (docs/theory.md, section 10):
+//  - original -> decimated: every original vertex, edge midpoint and triangle centroid is
+//    assigned to a current triangle within the tolerance (as OpenMesh's ModHausdorffT does for
+//    the vertices alone); a collapse must find such a triangle, among those it creates or the
+//    others nearby, for every sample of the triangles it removes or replaces;
+//  - decimated -> original: the points of barycentric coordinates (i, j, k) / 4 of every
+//    triangle a collapse creates lie within the tolerance of an original triangle.
 // Nearby triangles come from uniform grids (TriangleGrid.h), so this is not limited to a
 // one-ring.
 #pragma once
@@ -20,14 +18,9 @@
 #include <OpenMesh/Tools/Decimater/ModBaseT.hh>
 
 #include "MeshTriangles.h"
-#include "TriangleCover.h"
 #include "TriangleIntersection.h"
 
 namespace surftrack::refine {
-
-/// How many times a triangle or a piece is cut in four before the distance bound gives up on
-/// proving it (TriangleCover.h): up to 4^3 pieces.
-inline constexpr int kDistanceCuts = 3;
 
 template <class MeshT>
 class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
@@ -38,49 +31,20 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
 
   explicit ModSampledDistanceT(MeshT& mesh) : Base(mesh, true) {}
   ~ModSampledDistanceT() override {
-    if (piecesOf_.is_valid()) Base::mesh().remove_property(piecesOf_);
+    if (samplesOf_.is_valid()) Base::mesh().remove_property(samplesOf_);
   }
+
+  /// The barycentric step of the samples of a created triangle: 1 / kSteps.
+  static constexpr int kSteps = 4;
 
   void set_tolerance(double tolerance) { tolerance_ = tolerance; }
 
-  /// For a mesh decimated before (a wall of a complex, DecimatedComplex.h): the surface it is
-  /// measured against is `original` instead of its faces at initialize(), and face f answers
-  /// for the pieces `pieces[f]` (of `original`, within the tolerance of f) instead of itself.
-  void set_history(std::vector<Triangle3> original, std::vector<std::vector<Triangle3>> pieces) {
-    historyOriginal_ = std::move(original);
-    historyPieces_ = std::move(pieces);
-    history_ = true;
-  }
-
-  /// The pieces of the original surface face f answers for now.
-  const std::vector<Triangle3>& pieces(FaceHandle f) { return Base::mesh().property(piecesOf_, f); }
-
   void initialize() override {
     MeshT& m = Base::mesh();
-    if (!piecesOf_.is_valid()) m.add_property(piecesOf_);
+    if (!samplesOf_.is_valid()) m.add_property(samplesOf_);
     original_.clear();
     originalBox_.clear();
     lastHit_ = 0;
-    if (history_) {
-      Box3 bounds = LiveTriangleGrid<MeshT>::boundsOf(m);
-      for (const Triangle3& t : historyOriginal_) {
-        const Box3 b = boxOf(t);
-        for (int k = 0; k < 3; ++k) {
-          bounds.lo[k] = std::min(bounds.lo[k], b.lo[k]);
-          bounds.hi[k] = std::max(bounds.hi[k], b.hi[k]);
-        }
-      }
-      originalGrid_.reset(bounds, 2 * std::max(tolerance_, meanEdgeLength(m)));
-      currentGrid_.build(m, tolerance_);
-      for (const Triangle3& t : historyOriginal_) {
-        originalGrid_.insert(std::uint32_t(original_.size()), 0, boxOf(t));
-        original_.push_back(t);
-        originalBox_.push_back(boxOf(t));
-      }
-      if (original_.empty()) throw std::logic_error("ModSampledDistanceT: a history without its original surface");
-      for (auto f : m.faces()) m.property(piecesOf_, f) = historyPieces_.at(std::size_t(f.idx()));
-      return;
-    }
     // Cells about twice the larger of the tolerance and the mean edge length: a triangle
     // meets a few cells, a query a few more.
     originalGrid_.reset(LiveTriangleGrid<MeshT>::boundsOf(m), 2 * std::max(tolerance_, meanEdgeLength(m)));
@@ -90,7 +54,19 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
       originalGrid_.insert(std::uint32_t(original_.size()), 0, boxOf(t));
       original_.push_back(t);
       originalBox_.push_back(boxOf(t));
-      m.property(piecesOf_, f).assign(1, t);
+      auto& list = m.property(samplesOf_, f);
+      list.clear();
+      list.push_back({(t[0][0] + t[1][0] + t[2][0]) / 3, (t[0][1] + t[1][1] + t[2][1]) / 3,
+                      (t[0][2] + t[1][2] + t[2][2]) / 3});
+    }
+    for (auto e : m.edges()) {
+      const auto h = m.halfedge_handle(e, 0);
+      const auto a = m.point(m.from_vertex_handle(h)), b = m.point(m.to_vertex_handle(h));
+      m.property(samplesOf_, m.face_handle(h)).push_back({(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2});
+    }
+    for (auto v : m.vertices()) {
+      const auto p = m.point(v);
+      m.property(samplesOf_, *m.vf_range(v).begin()).push_back(pointOf(p));
     }
   }
 
@@ -103,70 +79,93 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
       created_.push_back(t);
       createdFace_.push_back(f);
     });
-    // Decimated -> original: each created triangle whole.
-    for (const Triangle3& t : created_)
-      if (!coverTriangle<std::uint32_t>(t, tolerance_, kDistanceCuts, [&](const Box3& box, auto&& visit) {
-            nearOriginal(box, visit);
-          }))
-        return float(Base::ILLEGAL_COLLAPSE);
-    // Original -> decimated: a piece of a face that the collapse keeps (with v1 for v0) is most
-    // often still near that face, so it is tried first; the face each piece is proven near is
-    // kept for postprocess_collapse.
+    const double e2 = tolerance_ * tolerance_;
+    // Decimated -> original. The distance to a triangle is a convex function, so when the
+    // three corners of a created triangle are within the tolerance of one original triangle,
+    // so is every point of it (its samples need no test).
+    for (const Triangle3& t : created_) {
+      std::uint32_t hit = 0;
+      if (!nearOriginal(t[0], e2, &hit)) return float(Base::ILLEGAL_COLLAPSE);
+      if (squaredDistanceToTriangle(t[1], original_[hit]) <= e2 &&
+          squaredDistanceToTriangle(t[2], original_[hit]) <= e2)
+        continue;
+      for (int i = 0; i <= kSteps; ++i)
+        for (int j = 0; i + j <= kSteps; ++j) {
+          const double a = double(i) / kSteps, b = double(j) / kSteps, c = 1 - a - b;
+          const Point3 p{a * t[0][0] + b * t[1][0] + c * t[2][0], a * t[0][1] + b * t[1][1] + c * t[2][1],
+                         a * t[0][2] + b * t[1][2] + c * t[2][2]};
+          if (!nearOriginal(p, e2, nullptr)) return float(Base::ILLEGAL_COLLAPSE);
+        }
+    }
+    // Original -> decimated: a sample of a face that the collapse keeps (with v1 for v0) is
+    // most often still near that face, so it is tried first; the face each sample is found
+    // near is kept for postprocess_collapse.
     assigned_.clear();
     for (auto f : m.vf_range(ci.v0)) {
       std::size_t own = created_.size();
       for (std::size_t i = 0; i < createdFace_.size(); ++i)
         if (createdFace_[i] == f) own = i;
-      for (const Triangle3& piece : m.property(piecesOf_, f))
-        if (!coverTriangle<FaceHandle>(piece, tolerance_, kDistanceCuts,
-                                       [&](const Box3& box, auto&& visit) {
-                                         if (own < created_.size() && visit(createdFace_[own], created_[own])) return;
-                                         for (std::size_t i = 0; i < created_.size(); ++i)
-                                           if (i != own && visit(createdFace_[i], created_[i])) return;
-                                         nearCurrent(box, ci.v0, visit);
-                                       },
-                                       &assigned_))
-          return float(Base::ILLEGAL_COLLAPSE);
+      for (const Point3& p : m.property(samplesOf_, f)) {
+        FaceHandle found;
+        if (own < created_.size() && squaredDistanceToTriangle(p, created_[own]) <= e2) found = f;
+        for (std::size_t i = 0; i < created_.size() && !found.is_valid(); ++i)
+          if (squaredDistanceToTriangle(p, created_[i]) <= e2) found = createdFace_[i];
+        if (!found.is_valid()) found = nearCurrent(p, e2, ci.v0);
+        if (!found.is_valid()) return float(Base::ILLEGAL_COLLAPSE);
+        assigned_.push_back(found);
+      }
     }
     return float(Base::LEGAL_COLLAPSE);
   }
 
   void preprocess_collapse(const CollapseInfo& ci) override {
     MeshT& m = Base::mesh();
-    for (auto f : m.vf_range(ci.v0)) m.property(piecesOf_, f).clear();
+    pending_.clear();
+    for (auto f : m.vf_range(ci.v0)) {
+      auto& list = m.property(samplesOf_, f);
+      pending_.insert(pending_.end(), list.begin(), list.end());
+      list.clear();
+    }
     // The collapse is the one just evaluated (CheckedDecimater.h asks every module right
-    // before it collapses), so the faces found there take the pieces.
-    if (evaluated_ != ci.v0v1) throw std::logic_error("ModSampledDistanceT: a collapse that was not just evaluated");
+    // before it collapses), so the faces found there take the samples.
+    if (evaluated_ != ci.v0v1 || assigned_.size() != pending_.size())
+      throw std::logic_error("ModSampledDistanceT: a collapse that was not just evaluated");
   }
 
   void postprocess_collapse(const CollapseInfo& ci) override {
     MeshT& m = Base::mesh();
-    for (const auto& [piece, f] : assigned_) m.property(piecesOf_, f).push_back(piece);
+    for (std::size_t k = 0; k < pending_.size(); ++k) m.property(samplesOf_, assigned_[k]).push_back(pending_[k]);
     currentGrid_.collapsed(m, ci.v1, ci.fl, ci.fr);
     evaluated_ = typename MeshT::HalfedgeHandle();
   }
 
  private:
-  /// Offers the original triangles whose boxes meet `box` (the last one proven near first).
-  template <class Visit>
-  void nearOriginal(const Box3& box, Visit&& visit) {
-    if (lastHit_ < original_.size() && originalBox_[lastHit_].meets(box) && visit(lastHit_, original_[lastHit_])) return;
-    bool stop = false;
-    originalGrid_.near(box, [&](std::uint32_t id, std::uint32_t) {
-      if (!stop && originalBox_[id].meets(box) && visit(id, original_[id])) {
-        stop = true;
+  /// p is within the tolerance of an original triangle (its index into *hit if asked).
+  bool nearOriginal(const Point3& p, double e2, std::uint32_t* hit) {
+    // Neighbouring samples are most often near the same original triangle: try it first.
+    if (squaredDistanceToTriangle(p, original_[lastHit_]) <= e2) {
+      if (hit) *hit = lastHit_;
+      return true;
+    }
+    bool found = false;
+    const Box3 query = boxOf({p, p, p}, tolerance_);
+    originalGrid_.near(query, [&](std::uint32_t id, std::uint32_t) {
+      // Only a triangle whose box meets the query box can be within the tolerance.
+      if (!found && originalBox_[id].meets(query) && squaredDistanceToTriangle(p, original_[id]) <= e2) {
+        found = true;
         lastHit_ = id;
       }
     });
+    if (found && hit) *hit = lastHit_;
+    return found;
   }
-  /// Offers the current triangles whose boxes meet `box` but those of `skip` (the collapsing
-  /// vertex).
-  template <class Visit>
-  void nearCurrent(const Box3& box, VertexHandle skip, Visit&& visit) {
+  /// A current triangle within the tolerance of p that does not have `skip` (the collapsing
+  /// vertex), or an invalid handle.
+  FaceHandle nearCurrent(const Point3& p, double e2, VertexHandle skip) {
     MeshT& m = Base::mesh();
-    bool stop = false;
-    currentGrid_.near(box, [&](FaceHandle f) {
-      if (stop) return;
+    FaceHandle found;
+    currentGrid_.near(boxOf({p, p, p}, tolerance_), [&](FaceHandle f) {
+      if (found.is_valid()) return;
       Triangle3 t;
       auto h = m.halfedge_handle(f);
       for (int k = 0; k < 3; ++k, h = m.next_halfedge_handle(h)) {
@@ -174,23 +173,21 @@ class ModSampledDistanceT : public OpenMesh::Decimater::ModBaseT<MeshT> {
         if (v == skip) return;
         t[k] = pointOf(m.point(v));
       }
-      stop = visit(f, t);
+      if (squaredDistanceToTriangle(p, t) <= e2) found = f;
     });
+    return found;
   }
 
   double tolerance_ = 1;
-  bool history_ = false;
-  std::vector<Triangle3> historyOriginal_;
-  std::vector<std::vector<Triangle3>> historyPieces_;
   std::vector<Triangle3> original_, created_;
   std::vector<Box3> originalBox_;
-  std::vector<FaceHandle> createdFace_;
-  std::vector<std::pair<Triangle3, FaceHandle>> assigned_;
+  std::vector<FaceHandle> createdFace_, assigned_;
+  std::vector<Point3> pending_;
   std::uint32_t lastHit_ = 0;
   typename MeshT::HalfedgeHandle evaluated_;
   TriangleGrid originalGrid_;
   LiveTriangleGrid<MeshT> currentGrid_;
-  OpenMesh::FPropHandleT<std::vector<Triangle3>> piecesOf_;  // each face's pieces, in place
+  OpenMesh::FPropHandleT<std::vector<Point3>> samplesOf_;  // each face's samples, in place
 };
 
 }  // namespace surftrack::refine

@@ -9,7 +9,7 @@
 #include <tuple>
 
 #include "Cancellation.h"
-#include "DistanceGuard.h"
+#include "ProvenDistanceGuard.h"
 #include "TriangleCover.h"
 #include "TriangleGrid.h"
 

@@ -3,8 +3,8 @@
 // allowed only if it
 //  - keeps the topology (ModTopologyGuardT: the link condition),
 //  - keeps the mesh embedded (ModEmbeddingGuardT: no new triangle meets another one),
-//  - keeps the surface within `maxError` of the original one both ways, for every point
-//    (ModSampledDistanceT, TriangleCover.h), and the quadric error below maxError^2 (ModQuadricT),
+//  - keeps the surface within `maxError` of the original one both ways, on samples
+//    (ModSampledDistanceT), and the quadric error below maxError^2 (ModQuadricT),
 //  - turns no triangle normal by more than `maxNormalDeviation` degrees (ModNormalFlippingT),
 //  - if a grid is given, keeps the mesh cut on its planes (ModGridLockT, for levels of detail).
 // A halfedge collapse moves no vertex: the survivors keep their points and their surfels.
@@ -21,7 +21,7 @@ namespace surftrack::refine {
 
 struct DecimationParameters {
   /// Largest distance, in the mesh's (physical) units, between the decimated and the original
-  /// surface, both ways, for every point (DistanceGuard.h); nothing: no bound.
+  /// surface, both ways, on samples (DistanceGuard.h); nothing: no bound.
   std::optional<double> maxError;
   /// Fraction of the triangles to remove, in [0, 1[ (VTK's TargetReduction); nothing: as many
   /// as the other bounds allow.
