@@ -245,13 +245,12 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
   // 5. The walls decimated in rounds, each wall a part of the way to its target in each round,
   //    so that no wall takes every chord between junction vertices before the next one starts
   //    (the link condition over the complex refuses a chord twice).
-  const int kRounds = rounds;
-  for (int round = 1; round <= kRounds; ++round)
+  for (int round = 1; round <= rounds; ++round)
     for (std::size_t k = 0; k < states.size(); ++k) {
       Wall& w = *states[k];
       Mesh& mesh = *w.mesh;
       const std::size_t n = w.ts.size();
-      std::size_t goal = n - (n - std::min(n, w.target)) * std::size_t(round) / std::size_t(kRounds);
+      std::size_t goal = n - (n - std::min(n, w.target)) * std::size_t(round) / std::size_t(rounds);
       // No region below its target (its walls' targets summed): after the junction lines'
       // collapses, some walls are below theirs and others above (JunctionLines.h, condition 5).
       const std::array<std::uint32_t, 2> regions = sides[w.ts[0]];
@@ -380,8 +379,7 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
 
   // The walls first, as far as they go with the junction lines locked; then, while a region is
   // above its target, the junction lines (JunctionLines.h) and the walls again on what those
-  // collapses freed, up to kJunctionPasses times (each pass frees less: on the 96³ Voronoi
-  // volume at F = 0.9, 82,271 -> 75,764 -> 72,128 -> 70,386 triangles for a target of 60,282).
+  // collapses freed, up to kJunctionPasses times (each pass frees less than the one before).
   report.lockedVertices = decimateWalls(c, p, 4);
   for (int pass = 0; pass < kJunctionPasses; ++pass) {
     bool above = false;

@@ -11,7 +11,7 @@
 // The complex's decimation uses it: its collapses along junction lines move the borders of
 // several walls at once, and there the samples of §10 missed points 4-14 % beyond the bound.
 // It refuses more collapses than the sampled bound (those it cannot prove), and on one surface
-// it made decimate() 2.3x slower (docs/performance.md), so decimate() keeps DistanceGuard.h.
+// it made decimate() about 2.3x slower (docs/theory.md §10), so decimate() keeps DistanceGuard.h.
 // Nearby triangles come from uniform grids (TriangleGrid.h), so this is not limited to a
 // one-ring.
 #pragma once
