@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -47,9 +48,13 @@ struct VertexTriangles {
   }
 };
 
+/// How far a wall goes in decimateWalls: to its own target, or past it while both its regions
+/// are above theirs (their excess shared among their walls by size).
+enum class WallGoal { OwnTarget, RegionShare };
+
 /// The walls' own decimation (docs/theory.md §12, "Decimating the complex", conditions 1-4) of
 /// the complex's live triangles, in `rounds` rounds; returns the vertices it found locked.
-std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, int rounds) {
+std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, int rounds, WallGoal mode) {
   const std::vector<Point3>& points = c.points;
   std::vector<Tri>& triangles = c.triangles;
   const std::vector<std::array<std::uint32_t, 2>>& sides = c.sides;
@@ -123,7 +128,11 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
   std::vector<std::unique_ptr<Wall>> states;  // (the modules' handles cannot be copied)
   std::vector<std::uint32_t> wallOf(triangles.size(), 0);  // 1 + the index in states of a triangle's wall mesh
   for (std::uint32_t wall = 0; wall < c.walls.size(); ++wall) {
-    if (c.target[wall] && c.live[wall] <= c.target[wall]) continue;
+    if (!p.targetReduction && mode == WallGoal::RegionShare) break;
+    if (mode == WallGoal::OwnTarget ? c.target[wall] && c.live[wall] <= c.target[wall]
+                                    : std::any_of(sides[c.walls[wall][0]].begin(), sides[c.walls[wall][0]].end(),
+                                                  [&](std::uint32_t r) { return c.regionLive[r] <= c.regionTarget[r]; }))
+      continue;
     std::vector<std::uint32_t> ts;
     for (std::uint32_t t : c.walls[wall])
       if (!removed[t]) ts.push_back(t);
@@ -245,20 +254,32 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
   // 5. The walls decimated in rounds, each wall a part of the way to its target in each round,
   //    so that no wall takes every chord between junction vertices before the next one starts
   //    (the link condition over the complex refuses a chord twice).
-  for (int round = 1; round <= rounds; ++round)
+  //    With WallGoal::RegionShare, a wall's share of a region's excess in a round is in
+  //    proportion to its live triangles among those of the region's walls decimated here.
+  std::vector<std::size_t> decimatedLive(c.regionLive.size(), 0);
+  for (int round = 1; round <= rounds; ++round) {
+    std::fill(decimatedLive.begin(), decimatedLive.end(), 0);
+    for (const auto& state : states)
+      for (std::uint32_t r : sides[state->ts[0]]) decimatedLive[r] += state->live;
     for (std::size_t k = 0; k < states.size(); ++k) {
       Wall& w = *states[k];
       Mesh& mesh = *w.mesh;
       const std::size_t n = w.ts.size();
-      std::size_t goal = n - (n - std::min(n, w.target)) * std::size_t(round) / std::size_t(rounds);
+      std::size_t goal = mode == WallGoal::OwnTarget
+                             ? n - (n - std::min(n, w.target)) * std::size_t(round) / std::size_t(rounds)
+                             : w.live + w.kept;
       // No region below its target (its walls' targets summed): after the junction lines'
       // collapses, some walls are below theirs and others above (JunctionLines.h, condition 5).
       const std::array<std::uint32_t, 2> regions = sides[w.ts[0]];
       if (p.targetReduction) {
         std::size_t excess = w.live + w.kept;
-        for (std::uint32_t r : regions)
-          excess = std::min(excess, c.regionLive[r] > c.regionTarget[r] ? c.regionLive[r] - c.regionTarget[r] : 0);
-        goal = std::max(goal, w.live + w.kept - excess);
+        for (std::uint32_t r : regions) {
+          const std::size_t over = c.regionLive[r] > c.regionTarget[r] ? c.regionLive[r] - c.regionTarget[r] : 0;
+          excess = std::min(excess, over);
+          if (mode == WallGoal::RegionShare && decimatedLive[r])
+            excess = std::min(excess, (over * w.live + decimatedLive[r] - 1) / decimatedLive[r]);
+        }
+        goal = mode == WallGoal::OwnTarget ? std::max(goal, w.live + w.kept - excess) : w.live + w.kept - excess;
       }
       const std::size_t meshGoal = goal > w.kept ? goal - w.kept : 0;
       if (w.live <= meshGoal) continue;
@@ -308,6 +329,7 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
       }
       for (std::uint32_t r : regions) c.regionLive[r] -= liveBefore - w.live;
     }
+  }
   // The walls' state handed back: their live triangles and the pieces each answers for.
   for (const auto& state : states) {
     Wall& w = *state;
@@ -327,7 +349,8 @@ constexpr int kJunctionPasses = 3;
 
 ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::vector<Tri>& triangles,
                                         const std::vector<std::array<std::uint32_t, 2>>& sides,
-                                        std::vector<char>& removed, const DecimationParameters& p) {
+                                        std::vector<char>& removed, const DecimationParameters& p,
+                                        std::optional<std::uint32_t> background) {
   requireDecimationParameters(p);
   if (sides.size() != triangles.size())
     throw std::invalid_argument("decimateComplex: " + std::to_string(triangles.size()) + " triangles but " +
@@ -366,6 +389,8 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
       c.regionTarget[r] += c.target.back();
     }
   }
+  // The background's surface is not made: no target of its own holds its walls back.
+  if (background && *background < regions) c.regionTarget[*background] = 0;
   // With a distance bound, each triangle is at first its own piece of the original surface
   // (ProvenDistanceGuard.h).
   if (p.maxError) {
@@ -380,7 +405,7 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
   // The walls first, as far as they go with the junction lines locked; then, while a region is
   // above its target, the junction lines (JunctionLines.h) and the walls again on what those
   // collapses freed, up to kJunctionPasses times (each pass frees less than the one before).
-  report.lockedVertices = decimateWalls(c, p, 4);
+  report.lockedVertices = decimateWalls(c, p, 4, WallGoal::OwnTarget);
   for (int pass = 0; pass < kJunctionPasses; ++pass) {
     bool above = false;
     for (std::size_t r = 0; r < c.regionLive.size(); ++r) above = above || c.regionLive[r] > c.regionTarget[r];
@@ -388,8 +413,11 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
     const std::size_t collapses = simplifyJunctionLines(c, p);
     report.junctionCollapses += collapses;
     if (!collapses) break;
-    decimateWalls(c, p, 2);
+    decimateWalls(c, p, 2, WallGoal::OwnTarget);
   }
+  // Last, what the locked walls could not give: the walls whose two regions are both still
+  // above target go past their own targets, each by its share of those regions' excess.
+  decimateWalls(c, p, 4, WallGoal::RegionShare);
   report.trianglesAfter = std::size_t(std::count(removed.begin(), removed.end(), 0));
   return report;
 }

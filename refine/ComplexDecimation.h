@@ -18,6 +18,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "TopologySafeDecimation.h"
@@ -40,12 +41,14 @@ struct ComplexDecimationReport {
 /// the orientation kept). The walls are decimated in rounds, each wall a part of the way to its
 /// target in each, then the junction lines (see ComplexDecimation.cpp). parameters.grid is not
 /// used; a reduction applies to each wall and each region (its walls' targets summed), as far
-/// as the guards allow.
+/// as the guards allow. A `background` region (a label map's, whose surface is not made) has
+/// no target of its own: its walls go as far as their other region's allows.
 /// \throw std::invalid_argument for parameters out of range (decimateSafely's), sizes that
 ///        differ or a vertex index out of range; Cancelled when parameters.cancel is raised.
 ComplexDecimationReport decimateComplex(const std::vector<Point3>& points,
                                         std::vector<std::array<std::uint32_t, 3>>& triangles,
                                         const std::vector<std::array<std::uint32_t, 2>>& sides,
-                                        std::vector<char>& removed, const DecimationParameters& parameters);
+                                        std::vector<char>& removed, const DecimationParameters& parameters,
+                                        std::optional<std::uint32_t> background = std::nullopt);
 
 }  // namespace surftrack::refine

@@ -826,12 +826,10 @@ TEST_P(Atlas, SharedWallsAreTwinsAndEveryLabelIsAManifold) {
 // §12): each triangle of a label has its reversed twin at bit-identical points in another label,
 // or lies on the background's wall (labelAt(v) == 0 for a voxel of each vertex's surfel); each
 // label closed, oriented, with the Euler characteristic and components of its undecimated self;
-// the labels' triangles within `slack` of their target (5 % on the Voronoi volume, AAL, brodmann,
-// HarvardOxford and jhu189; the thin white-matter tracts of JHU and AICHAmc's small regions
-// keep 6-24 % more, measured 2026-12-03: their bound is 25 %, a guard against a regression).
+// the labels' triangles, summed, within 5 % of their target (the bound; one label alone
+// may keep more where its thin tracts refuse collapses, the table's per-label figures).
 template <class LabelAt>
-void checkSmoothedDecimatedComplex(const VolumeView& view, LabelAt&& labelAt, const std::string& name,
-                                   double slack) {
+void checkSmoothedDecimatedComplex(const VolumeView& view, LabelAt&& labelAt, const std::string& name) {
   LabelOptions options;
   options.walls = LabelWalls::Shared;
   const auto before = extractLabels(view, options);
@@ -888,7 +886,7 @@ void checkSmoothedDecimatedComplex(const VolumeView& view, LabelAt&& labelAt, co
     }
   }
   EXPECT_GT(twins, 0u);
-  EXPECT_LE(double(triangles), (1 + slack) * double(target));
+  EXPECT_LE(double(triangles), 1.05 * double(target));
   std::cout << "[ study ] " << name << ", smooth 10, reduce 0.8: " << triangles << " triangles for a target of "
             << target << ", " << twins << " with their twin\n";
 }
@@ -905,7 +903,7 @@ TEST_P(Atlas, SmoothedAndDecimatedComplexKeepsItsWallsAndTopology) {
           if (!dims.contains(v)) return 0;
           return (long long)image.data()[std::size_t(v.x + std::int64_t(dims.nx) * (v.y + std::int64_t(dims.ny) * v.z))];
         },
-        GetParam(), std::string(GetParam()).rfind("JHU", 0) == 0 || std::string(GetParam()).rfind("AICHA", 0) == 0 ? 0.25 : 0.05);
+        GetParam());
   });
 }
 
@@ -932,7 +930,7 @@ TEST(Labels, SmoothedAndDecimatedVoronoiComplexKeepsItsWallsAndTopology) {
       [&](const Voxel& v) -> long long {
         return dims.contains(v) ? labels[std::size_t(v.x + dims.nx * (v.y + std::int64_t(dims.ny) * v.z))] : 0;
       },
-      "Voronoi 40^3, 60 cells", 0.05);
+      "Voronoi 40^3, 60 cells");
 }
 
 INSTANTIATE_TEST_SUITE_P(MricronData, Atlas,

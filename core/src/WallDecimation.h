@@ -17,6 +17,7 @@ namespace surftrack {
 
 /// Decimates the complex of shared walls `triangles` (each wall once, between the regions
 /// sides[t]) over `points` (physical) in place; removed[t] then says whether triangle t is gone.
+/// Region 0 is the background (SharedWallLabels.h's priorities): no surface, no target.
 inline refine::ComplexDecimationReport decimateWalls(const std::vector<refine::Point3>& points,
                                                      std::vector<std::array<std::uint32_t, 3>>& triangles,
                                                      const std::vector<std::array<std::uint32_t, 2>>& sides,
@@ -31,7 +32,7 @@ inline refine::ComplexDecimationReport decimateWalls(const std::vector<refine::P
   // As decimate(): a bad argument is the caller's, a broken invariant the engine's (the order of
   // the handlers matters: std::invalid_argument is a std::logic_error).
   try {
-    return refine::decimateComplex(points, triangles, sides, removed, p);
+    return refine::decimateComplex(points, triangles, sides, removed, p, 0);
   } catch (const std::invalid_argument& e) {
     throw InvalidInput(e.what());
   } catch (const std::logic_error& e) {
