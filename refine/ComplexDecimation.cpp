@@ -48,9 +48,12 @@ struct VertexTriangles {
   }
 };
 
-/// How far a wall goes in decimateWalls: to its own target, or past it while both its regions
-/// are above theirs (their excess shared among their walls by size).
-enum class WallGoal { OwnTarget, RegionShare };
+/// How far a wall goes in decimateWalls: to its own target; past it while both its regions are
+/// above theirs (their excess shared among their walls by size); or, when balancing, for a
+/// region still above its target, past it while the other region may lose more
+/// (DecimatedComplex::mayLose: the region's excess shared among its walls by size, the other's
+/// slack taken first come first served).
+enum class WallGoal { OwnTarget, RegionShare, Balance };
 
 /// The walls' own decimation (docs/theory.md §12, "Decimating the complex", conditions 1-4) of
 /// the complex's live triangles, in `rounds` rounds; returns the vertices it found locked.
@@ -128,11 +131,15 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
   std::vector<std::unique_ptr<Wall>> states;  // (the modules' handles cannot be copied)
   std::vector<std::uint32_t> wallOf(triangles.size(), 0);  // 1 + the index in states of a triangle's wall mesh
   for (std::uint32_t wall = 0; wall < c.walls.size(); ++wall) {
-    if (!p.targetReduction && mode == WallGoal::RegionShare) break;
-    if (mode == WallGoal::OwnTarget ? c.target[wall] && c.live[wall] <= c.target[wall]
-                                    : std::any_of(sides[c.walls[wall][0]].begin(), sides[c.walls[wall][0]].end(),
-                                                  [&](std::uint32_t r) { return c.regionLive[r] <= c.regionTarget[r]; }))
-      continue;
+    if (!p.targetReduction && mode != WallGoal::OwnTarget) break;
+    const std::array<std::uint32_t, 2> pair = sides[c.walls[wall][0]];
+    const bool skip =
+        mode == WallGoal::OwnTarget      ? c.target[wall] && c.live[wall] <= c.target[wall]
+        : mode == WallGoal::RegionShare ? std::any_of(pair.begin(), pair.end(),
+                                                      [&](std::uint32_t r) { return c.regionLive[r] <= c.regionTarget[r]; })
+                                        : !(c.aboveTarget(pair[0]) || c.aboveTarget(pair[1])) ||
+                                              !c.mayLose(pair[0]) || !c.mayLose(pair[1]);
+    if (skip) continue;
     std::vector<std::uint32_t> ts;
     for (std::uint32_t t : c.walls[wall])
       if (!removed[t]) ts.push_back(t);
@@ -268,17 +275,25 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
       std::size_t goal = mode == WallGoal::OwnTarget
                              ? n - (n - std::min(n, w.target)) * std::size_t(round) / std::size_t(rounds)
                              : w.live + w.kept;
-      // No region below its target (its walls' targets summed): after the junction lines'
+      // No region below its target (the reduction of its triangles): after the junction lines'
       // collapses, some walls are below theirs and others above (JunctionLines.h, condition 5).
       const std::array<std::uint32_t, 2> regions = sides[w.ts[0]];
       if (p.targetReduction) {
         std::size_t excess = w.live + w.kept;
+        bool asked = mode != WallGoal::Balance;  // (balancing: some region above its target asks)
         for (std::uint32_t r : regions) {
-          const std::size_t over = c.regionLive[r] > c.regionTarget[r] ? c.regionLive[r] - c.regionTarget[r] : 0;
+          const std::size_t over = c.mayLose(r);
+          if (mode == WallGoal::Balance && !c.aboveTarget(r)) {
+            // Its slack, as it comes, in whole collapses (two triangles each): never below its floor.
+            excess = std::min(excess, over - over % 2);
+            continue;
+          }
           excess = std::min(excess, over);
-          if (mode == WallGoal::RegionShare && decimatedLive[r])
+          asked = asked || c.aboveTarget(r);
+          if (mode != WallGoal::OwnTarget && decimatedLive[r])
             excess = std::min(excess, (over * w.live + decimatedLive[r] - 1) / decimatedLive[r]);
         }
+        if (!asked) excess = 0;
         goal = mode == WallGoal::OwnTarget ? std::max(goal, w.live + w.kept - excess) : w.live + w.kept - excess;
       }
       const std::size_t meshGoal = goal > w.kept ? goal - w.kept : 0;
@@ -384,11 +399,13 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
     c.live.push_back(ts.size());
     c.target.push_back(p.targetReduction ? std::size_t(std::llround((1 - *p.targetReduction) * double(ts.size()))) : 0);
     report.targetTriangles += c.target.back();
-    for (std::uint32_t r : sides[ts[0]]) {
-      c.regionLive[r] += c.live.back();
-      c.regionTarget[r] += c.target.back();
-    }
+    for (std::uint32_t r : sides[ts[0]]) c.regionLive[r] += c.live.back();
   }
+  // A region's target is its own share of its triangles (as its label's report states it), not
+  // its walls' targets summed, each rounded.
+  if (p.targetReduction)
+    for (std::size_t r = 0; r < regions; ++r)
+      c.regionTarget[r] = std::size_t(std::llround((1 - *p.targetReduction) * double(c.regionLive[r])));
   // The background's surface is not made: no target of its own holds its walls back.
   if (background && *background < regions) c.regionTarget[*background] = 0;
   // With a distance bound, each triangle is at first its own piece of the original surface
@@ -418,6 +435,22 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
   // Last, what the locked walls could not give: the walls whose two regions are both still
   // above target go past their own targets, each by its share of those regions' excess.
   decimateWalls(c, p, 4, WallGoal::RegionShare);
+  // And a region still above its target takes a little more from its neighbours at theirs
+  // (DecimatedComplex::balancing), its walls first, then its junction lines and its walls again.
+  if (p.targetReduction) {
+    c.balancing = true;
+    for (int pass = 0; pass <= kJunctionPasses; ++pass) {
+      bool above = false;
+      for (std::uint32_t r = 0; r < c.regionLive.size(); ++r) above = above || c.aboveTarget(r);
+      if (!above) break;
+      if (pass) {
+        const std::size_t collapses = simplifyJunctionLines(c, p);
+        report.junctionCollapses += collapses;
+        if (!collapses) break;
+      }
+      decimateWalls(c, p, pass ? 2 : 4, WallGoal::Balance);
+    }
+  }
   report.trianglesAfter = std::size_t(std::count(removed.begin(), removed.end(), 0));
   return report;
 }

@@ -40,7 +40,7 @@ struct ComplexDecimationReport {
 /// triangles[t] holds a survivor's vertices (a removed vertex replaced by the one it went into;
 /// the orientation kept). The walls are decimated in rounds, each wall a part of the way to its
 /// target in each, then the junction lines (see ComplexDecimation.cpp). parameters.grid is not
-/// used; a reduction applies to each wall and each region (its walls' targets summed), as far
+/// used; a reduction applies to each wall and each region (the reduction of its triangles), as far
 /// as the guards allow. A `background` region (a label map's, whose surface is not made) has
 /// no target of its own: its walls go as far as their other region's allows.
 /// \throw std::invalid_argument for parameters out of range (decimateSafely's), sizes that

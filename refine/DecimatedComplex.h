@@ -32,6 +32,23 @@ struct DecimatedComplex {
   std::vector<Triangle3> original{};                 ///< by triangle (with a distance bound)
   std::vector<std::vector<Triangle3>> pieces{};      ///< by live triangle (with a distance bound)
 
+  /// Once the regions' targets are met as far as they go, a region at its target may still give
+  /// up to 1/kSlack of it (4 %) to a neighbour above its own, so that both end within 5 % of
+  /// theirs (docs/theory.md §12, "Decimating the complex"): then `balancing` is set.
+  static constexpr std::size_t kSlack = 25;
+  bool balancing = false;
+
+  /// Region r is above a target of its own (the background, with none, never is).
+  bool aboveTarget(std::uint32_t r) const { return regionTarget[r] > 0 && regionLive[r] > regionTarget[r]; }
+
+  /// How many more triangles region r may lose: down to its target, or, when balancing and it
+  /// is not above its target, down to its floor (the background, with no target, all).
+  std::size_t mayLose(std::uint32_t r) const {
+    const std::size_t floor =
+        balancing && !aboveTarget(r) ? regionTarget[r] - regionTarget[r] / kSlack : regionTarget[r];
+    return regionLive[r] > floor ? regionLive[r] - floor : 0;
+  }
+
   Triangle3 triangleAt(std::uint32_t t) const {
     return {points[triangles[t][0]], points[triangles[t][1]], points[triangles[t][2]]};
   }

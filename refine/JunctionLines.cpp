@@ -79,8 +79,11 @@ class JunctionLines {
       if (!lineNeighbours(v, line) || singularVertex(v, at_[v], c_.triangles, c_.sides)) continue;
       // Condition 5 (JunctionLines.h), for every region at v: each loses two triangles.
       const std::vector<std::uint32_t> regions = regionsOf(at_[v], c_.sides);
-      if (std::any_of(regions.begin(), regions.end(),
-                      [&](std::uint32_t r) { return c_.regionLive[r] <= c_.regionTarget[r]; }))
+      // When balancing, some region at v must be above its target, and every region may lose its
+      // two triangles without going below its floor.
+      const std::size_t loses = c_.balancing ? 2 : 1;
+      if (std::any_of(regions.begin(), regions.end(), [&](std::uint32_t r) { return c_.mayLose(r) < loses; }) ||
+          (c_.balancing && std::none_of(regions.begin(), regions.end(), [&](std::uint32_t r) { return c_.aboveTarget(r); })))
         continue;
       // The shorter edge first: its triangles are the smaller ones to lose.
       const Point3& x = c_.points[v];

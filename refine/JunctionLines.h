@@ -16,8 +16,10 @@
 //  4. with a distance bound E, every changed triangle lies within E of its wall's original
 //     triangles, and every sample its wall's removed and changed triangles answered for is
 //     within E of one of that wall's triangles after it, whole (ProvenDistanceGuard.h's two ways);
-//  5. every region at v is still above its target (its walls' targets summed): a wall may go
-//     below its own where its regions' other walls could not reach theirs.
+//  5. every region at v is still above its target (the reduction of its triangles): a wall may go
+//     below its own where its regions' other walls could not reach theirs; when balancing
+//     (DecimatedComplex::balancing), some region at v is above its target and every other may
+//     lose its two triangles above its floor.
 // The candidates go cheapest first: by the distance from v to the line's chord that replaces it.
 #pragma once
 
