@@ -41,8 +41,10 @@ struct ComplexDecimationReport {
 /// the orientation kept). The walls are decimated in rounds, each wall a part of the way to its
 /// target in each, then the junction lines (see ComplexDecimation.cpp). parameters.grid is not
 /// used; a reduction applies to each wall and each region (the reduction of its triangles), as far
-/// as the guards allow. A `background` region (a label map's, whose surface is not made) has
-/// no target of its own: its walls go as far as their other region's allows.
+/// as the guards allow, and last a region still above its target takes up to 4 % of theirs from
+/// its neighbours (DecimatedComplex::balancing): a region ends at most 4 % of its target and one
+/// collapse below it. A `background` region (a label map's, whose surface is not made) has no
+/// target of its own: its walls go as far as their other region's allows.
 /// \throw std::invalid_argument for parameters out of range (decimateSafely's), sizes that
 ///        differ or a vertex index out of range; Cancelled when parameters.cancel is raised.
 ComplexDecimationReport decimateComplex(const std::vector<Point3>& points,
