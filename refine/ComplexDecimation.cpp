@@ -133,13 +133,10 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
   for (std::uint32_t wall = 0; wall < c.walls.size(); ++wall) {
     if (!p.targetReduction && mode != WallGoal::OwnTarget) break;
     const std::array<std::uint32_t, 2> pair = sides[c.walls[wall][0]];
-    const bool skip =
-        mode == WallGoal::OwnTarget      ? c.target[wall] && c.live[wall] <= c.target[wall]
-        : mode == WallGoal::RegionShare ? std::any_of(pair.begin(), pair.end(),
-                                                      [&](std::uint32_t r) { return c.regionLive[r] <= c.regionTarget[r]; })
-                                        : !(c.aboveTarget(pair[0]) || c.aboveTarget(pair[1])) ||
-                                              !c.mayLose(pair[0]) || !c.mayLose(pair[1]);
-    if (skip) continue;
+    if (mode == WallGoal::OwnTarget ? c.target[wall] && c.live[wall] <= c.target[wall]
+                                    : !c.mayLose(pair[0]) || !c.mayLose(pair[1]) ||
+                                          (mode == WallGoal::Balance && !c.aboveTarget(pair[0]) && !c.aboveTarget(pair[1])))
+      continue;
     std::vector<std::uint32_t> ts;
     for (std::uint32_t t : c.walls[wall])
       if (!removed[t]) ts.push_back(t);
@@ -280,7 +277,6 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
       const std::array<std::uint32_t, 2> regions = sides[w.ts[0]];
       if (p.targetReduction) {
         std::size_t excess = w.live + w.kept;
-        bool asked = mode != WallGoal::Balance;  // (balancing: some region above its target asks)
         for (std::uint32_t r : regions) {
           const std::size_t over = c.mayLose(r);
           if (mode == WallGoal::Balance && !c.aboveTarget(r)) {
@@ -289,11 +285,11 @@ std::size_t decimateWalls(DecimatedComplex& c, const DecimationParameters& p, in
             continue;
           }
           excess = std::min(excess, over);
-          asked = asked || c.aboveTarget(r);
           if (mode != WallGoal::OwnTarget && decimatedLive[r])
             excess = std::min(excess, (over * w.live + decimatedLive[r] - 1) / decimatedLive[r]);
         }
-        if (!asked) excess = 0;
+        // Balancing, only a region above its target asks (its neighbours may have given it all).
+        if (mode == WallGoal::Balance && !c.aboveTarget(regions[0]) && !c.aboveTarget(regions[1])) excess = 0;
         goal = mode == WallGoal::OwnTarget ? std::max(goal, w.live + w.kept - excess) : w.live + w.kept - excess;
       }
       const std::size_t meshGoal = goal > w.kept ? goal - w.kept : 0;
@@ -425,7 +421,7 @@ ComplexDecimationReport decimateComplex(const std::vector<Point3>& points, std::
   report.lockedVertices = decimateWalls(c, p, 4, WallGoal::OwnTarget);
   for (int pass = 0; pass < kJunctionPasses; ++pass) {
     bool above = false;
-    for (std::size_t r = 0; r < c.regionLive.size(); ++r) above = above || c.regionLive[r] > c.regionTarget[r];
+    for (std::uint32_t r = 0; r < c.regionLive.size(); ++r) above = above || c.mayLose(r);  // (no target: any)
     if (!above) break;
     const std::size_t collapses = simplifyJunctionLines(c, p);
     report.junctionCollapses += collapses;
