@@ -338,7 +338,10 @@ def _map_blocks(client, task, source, blocks, args, progress):
     the futures in block order."""
     from dask.distributed import as_completed
     if isinstance(source, np.ndarray):  # sent to the workers once, not with every task
-        source = client.scatter(source, broadcast=False)
+        # Under a key of its own (hash=False): under the content's hash, a second run on the same
+        # array reuses the key while the first run's release of it is still on its way to the
+        # scheduler, which then forgets the array under the new run's blocks and cancels them.
+        source = client.scatter(source, broadcast=False, hash=False)
     futures = [client.submit(task, source, lo, hi, *args,
                              key=f"surftrack-block-{lo[0]}-{lo[1]}-{lo[2]}-{uuid.uuid4().hex[:8]}", pure=False)
                for lo, hi in blocks]

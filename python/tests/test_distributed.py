@@ -170,6 +170,17 @@ def test_a_work_dir_reused_with_other_arguments_recomputes(client, tmp_path):
     assert len(list(work.iterdir())) == 2 * len(blocks.block_grid(labels.shape, (5, 5, 5)))
 
 
+def test_the_same_array_run_back_to_back_on_one_client(client):
+    # Each run scatters the array once. Under a key derived from the content, the next run reused
+    # that key while the previous run's release of it was still in flight: the scheduler then
+    # forgot the array beneath the new run's blocks, cancelling them (about 3 runs in 100) or
+    # leaving the run waiting forever. Sixty runs back to back, each the single pass's surfaces.
+    labels = random_labels(np.random.default_rng(23), (10, 9, 11))
+    want = surftrack.label_surfaces(labels, walls="independent")
+    for _ in range(60):
+        expect_same(blocks.label_surfaces(labels, block=(5, 5, 5), client=client), want)
+
+
 def test_labels_over_the_merge_budget_get_exact_figures_and_streamed_files(client, tmp_path):
     """write_label_meshes with a merge_budget some labels exceed: those get the single pass's
     figures (counts exactly, area and volume within 1e-9 relative: summed by groups of blocks,
