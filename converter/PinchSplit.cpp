@@ -130,17 +130,30 @@ std::vector<std::uint64_t> crowdedEdges(std::size_t vertexCount, const PinchSpli
 PinchSplit splitPinches(const std::vector<std::array<double, 3>>& points,
                         const std::vector<std::array<std::uint32_t, 3>>& triangles) {
   // Every triangle side as (low vertex, high vertex, triangle, corner of its first vertex),
-  // sorted so that the sides of one edge are together.
-  std::vector<Side> sides;
-  sides.reserve(3 * triangles.size());
-  for (std::uint32_t t = 0; t < triangles.size(); ++t)
-    for (std::uint8_t j = 0; j < 3; ++j) {
-      const std::uint32_t a = triangles[t][j], b = triangles[t][(j + 1) % 3];
-      sides.push_back({std::min(a, b), std::max(a, b), t, j});
+  // sorted by (lo, hi, triangle) so that the sides of one edge are together: placed by lo
+  // (count, prefix sum, fill, in triangle order), then each vertex's few sorted by hi.
+  std::vector<std::uint32_t> start(points.size() + 1, 0);
+  for (const auto& t : triangles)
+    for (std::uint8_t j = 0; j < 3; ++j) ++start[std::size_t(std::min(t[j], t[(j + 1) % 3])) + 1];
+  for (std::size_t v = 0; v < points.size(); ++v) start[v + 1] += start[v];
+  std::vector<Side> sides(3 * triangles.size());
+  {
+    std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      for (std::uint8_t j = 0; j < 3; ++j) {
+        const std::uint32_t a = triangles[t][j], b = triangles[t][(j + 1) % 3];
+        sides[next[std::min(a, b)]++] = {std::min(a, b), std::max(a, b), t, j};
+      }
+  }
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    const auto first = sides.begin() + start[v], last = sides.begin() + start[v + 1];
+    if (last - first > 32) {  // (a vertex of the digital surfaces has a few dozen sides at most)
+      std::sort(first, last, [](const Side& x, const Side& y) { return x.hi != y.hi ? x.hi < y.hi : x.triangle < y.triangle; });
+      continue;
     }
-  std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
-    return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.triangle < y.triangle;
-  });
+    for (auto i = first + 1; i < last; ++i)  // insertion: stable, equal hi stay in triangle order
+      for (auto k = i; k > first && k->hi < (k - 1)->hi; --k) std::iter_swap(k, k - 1);
+  }
   PinchSplit out;
   pairAndCopy(points, triangles, sides, {}, out);
   if (out.pinchedEdges == 0) return out;  // (copies never crowd an edge)

@@ -17,7 +17,7 @@ class FlatKeyMap {
   /// The value of `key`, inserting `value` for it if it is absent; whether it was inserted.
   /// `key` must not be ~0 (the empty slot).
   std::pair<std::uint32_t, bool> tryEmplace(std::uint64_t key, std::uint32_t value) {
-    if (2 * (size_ + 1) > keys_.size()) grow();
+    if (2 * (size_ + 1) > keys_.size()) grow(keys_.empty() ? 64 : 2 * keys_.size());
     const std::size_t mask = keys_.size() - 1;
     for (std::size_t i = std::size_t(mix64(key)) & mask;; i = (i + 1) & mask) {
       if (keys_[i] == key) return {values_[i], false};
@@ -29,6 +29,12 @@ class FlatKeyMap {
       }
     }
   }
+  /// Room for `count` keys without growing (the table's load stays at most 1/2).
+  void reserve(std::size_t count) {
+    std::size_t slots = keys_.empty() ? 64 : keys_.size();
+    while (slots < 2 * count) slots *= 2;
+    if (slots > keys_.size()) grow(slots);
+  }
   std::size_t size() const { return size_; }
   /// Frees the table.
   void clear() {
@@ -39,8 +45,8 @@ class FlatKeyMap {
 
  private:
   static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
-  void grow() {
-    std::vector<std::uint64_t> keys(keys_.empty() ? 64 : 2 * keys_.size(), kEmpty);
+  void grow(std::size_t slots) {  // (a power of two)
+    std::vector<std::uint64_t> keys(slots, kEmpty);
     std::vector<std::uint32_t> values(keys.size());
     const std::size_t mask = keys.size() - 1;
     for (std::size_t j = 0; j < keys_.size(); ++j)

@@ -648,14 +648,17 @@ namespace surftrack {
 namespace {
 
 /// lib/FlatKeyMap.h, which numbers the vertices of the shared walls' scan, against
-/// std::unordered_map on random keys with repeats (the table grows many times).
+/// std::unordered_map on random keys with repeats (the table grows many times), with and
+/// without room reserved ahead (at the start and part of the way).
 TEST(FlatKeyMap, AgreesWithAnUnorderedMap) {
   std::mt19937_64 rng(7);
-  for (const std::uint64_t range : {std::uint64_t(50), std::uint64_t(1) << 20, ~std::uint64_t(0) - 1}) {
+  for (const std::uint64_t range : {std::uint64_t(50), std::uint64_t(1) << 20, ~std::uint64_t(0) - 1})
+  for (const std::size_t reserveAt : {std::size_t(0), std::size_t(1000), std::size_t(1) << 30}) {
     FlatKeyMap flat;
     std::unordered_map<std::uint64_t, std::uint32_t> reference;
     std::uniform_int_distribution<std::uint64_t> key(0, range);
     for (std::uint32_t i = 0; i < 200000; ++i) {
+      if (i == reserveAt) flat.reserve(150000);
       const std::uint64_t k = key(rng);
       const auto [it, added] = reference.try_emplace(k, i);
       ASSERT_EQ(flat.tryEmplace(k, i), std::make_pair(it->second, added)) << "key " << k;

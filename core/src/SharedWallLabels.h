@@ -11,16 +11,20 @@
 // LabelOptions::decimate the complex (smoothed or not) is decimated wall by wall
 // (WallDecimation.h), and each label's triangles are its walls' survivors, over its own vertices
 // (a pinch's copies kept where they were: the decimation never touches a pinch).
-// One thread for the scan, the labels' meshes then finished in parallel; the same for any
-// `threads`.
+// The priorities and the walls are found by slabs of planes in parallel and put together in
+// slab order, the complex (with smoothing or decimation) numbered in one pass over the walls,
+// and each label's mesh built from its own walls and finished in parallel, so the meshes are
+// those of one scan in cube order, the same for any `threads`.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
-#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -32,6 +36,7 @@
 #include "ComplexSmoothing.h"
 #include "DigitalCube.h"
 #include "FlatKeyMap.h"
+#include "HugePages.h"
 #include "Image.h"
 #include "Labels.h"
 #include "NestedWalls.h"
@@ -50,127 +55,205 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
                                              const LabelOptions& o, Select&& select) {
   const Dims dims = image.dims;
   const T background = o.background.as<T>();
+  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
+  auto cancelled = [&] { return o.cancel && o.cancel->load(std::memory_order_relaxed); };
+  // Slabs of planes [z0, z1) for the parallel passes: a few per thread. Each pass's result is
+  // put together in slab order, so it is the one-thread scan's whatever the count.
+  auto slabs = [&](int z0, int z1) {
+    const int parts = std::clamp(2 * arena.max_concurrency(), 1, std::max(1, z1 - z0));
+    std::vector<std::pair<int, int>> out(std::size_t(parts), {0, 0});
+    for (int k = 0; k < parts; ++k)
+      out[std::size_t(k)] = {z0 + int(std::int64_t(z1 - z0) * k / parts), z0 + int(std::int64_t(z1 - z0) * (k + 1) / parts)};
+    return out;
+  };
+  const std::size_t nx = std::size_t(dims.nx), nxy = nx * std::size_t(dims.ny), voxelCount = nxy * std::size_t(dims.nz);
+
   // 1. Priorities: the background (and every voxel outside the domain) 0, the labels 1, 2, ...
-  //    by increasing value.
+  //    by increasing value. The labels are found by runs of equal values (slabs in parallel).
+  const auto planeSlabs = slabs(0, dims.nz);
+  std::vector<std::vector<T>> found(planeSlabs.size());
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), planeSlabs.size(), [&](std::size_t k) {
+      std::vector<T>& f = found[k];
+      for (int z = planeSlabs[k].first; z < planeSlabs[k].second; ++z)
+        for (int y = 0; y < dims.ny; ++y)
+          for (int x = 0; x < dims.nx; ++x) {
+            const T v = image.at(x, y, z);
+            if (v != background && (f.empty() || v != f.back())) f.push_back(v);
+          }
+      std::sort(f.begin(), f.end());
+      f.erase(std::unique(f.begin(), f.end()), f.end());
+    });
+  });
   std::vector<T> labels;
-  labels.reserve(std::size_t(dims.nx) * std::size_t(dims.ny) * std::size_t(dims.nz));
-  for (int z = 0; z < dims.nz; ++z)
-    for (int y = 0; y < dims.ny; ++y)
-      for (int x = 0; x < dims.nx; ++x)
-        if (image.at(x, y, z) != background) labels.push_back(image.at(x, y, z));
+  for (auto& f : found) {
+    labels.insert(labels.end(), f.begin(), f.end());
+    std::vector<T>().swap(f);
+  }
   std::sort(labels.begin(), labels.end());
   labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
   const std::vector<std::size_t> selected = select(labels);
-  std::vector<std::uint32_t> priority(std::size_t(dims.nx) * std::size_t(dims.ny) * std::size_t(dims.nz));
+  // Written once, in parallel: fresh memory on huge pages (lib/HugePages.h).
+  const FreshArray<std::uint32_t> priority = freshArray<std::uint32_t>(voxelCount);
+  std::vector<std::vector<std::uint64_t>> slabVoxels(planeSlabs.size());
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), planeSlabs.size(), [&](std::size_t k) {
+      std::vector<std::uint64_t>& count = slabVoxels[k];
+      count.assign(labels.size() + 1, 0);
+      T last = background;
+      std::uint32_t p = 0;
+      for (int z = planeSlabs[k].first; z < planeSlabs[k].second; ++z)
+        for (int y = 0; y < dims.ny; ++y) {
+          std::uint32_t* row = priority.get() + std::size_t(z) * nxy + std::size_t(y) * nx;
+          for (int x = 0; x < dims.nx; ++x) {
+            const T v = image.at(x, y, z);
+            if (v != last) {
+              last = v;
+              p = v == background ? 0u
+                                  : std::uint32_t(std::lower_bound(labels.begin(), labels.end(), v) - labels.begin()) + 1;
+            }
+            row[x] = p;
+            ++count[p];
+          }
+        }
+    });
+  });
   std::vector<std::uint64_t> voxels(labels.size() + 1, 0);
-  for (int z = 0, i = 0; z < dims.nz; ++z)
-    for (int y = 0; y < dims.ny; ++y)
-      for (int x = 0; x < dims.nx; ++x, ++i) {
-        const T v = image.at(x, y, z);
-        const auto p = v == background
-                           ? 0u
-                           : std::uint32_t(std::lower_bound(labels.begin(), labels.end(), v) - labels.begin()) + 1;
-        priority[std::size_t(i)] = p;
-        ++voxels[p];
-      }
+  for (auto& count : slabVoxels) {
+    for (std::size_t p = 0; p < count.size(); ++p) voxels[p] += count[p];
+    std::vector<std::uint64_t>().swap(count);
+  }
   auto priorityAt = [&](const Voxel& v) -> std::uint32_t {
     if (!dims.contains(v)) return 0;
-    return priority[std::size_t(v.x) + std::size_t(dims.nx) * (std::size_t(v.y) + std::size_t(dims.ny) * std::size_t(v.z))];
+    return priority[std::size_t(v.x) + nx * std::size_t(v.y) + nxy * std::size_t(v.z)];
   };
 
-  // 2. Each selected label's mesh, in grid edges.
-  struct Building {
-    FlatKeyMap vertexOf;  // grid edge key -> vertex
-    std::vector<Surfel> surfels;
-    std::vector<std::array<std::uint32_t, 3>> triangles;
-    std::vector<std::uint32_t> complexVertex;  // with smoothing or decimation: each vertex's in the complex
-    std::vector<std::uint32_t> complexTriangle;  // with decimation: each triangle's in the complex
-    std::vector<char> reversed;                  // ... and whether it is that one reversed
+  // 2. The walls, in the order of the cubes (slabs of cube planes in parallel): each wall
+  //    triangle as its cube (index of m + (1, 1, 1) in the grid of cubes), its three cube edges
+  //    and the priorities of its two sides.
+  const std::uint64_t cx = std::uint64_t(dims.nx) + 1, cxy = cx * (std::uint64_t(dims.ny) + 1);
+  if (cxy * (std::uint64_t(dims.nz) + 1) >= std::uint64_t(1) << 52)
+    throw std::length_error("shared walls: more than 2^52 cubes");
+  struct Wall {
+    std::uint64_t cubeAndEdges;  // cube | edge 0 << 52 | edge 1 << 56 | edge 2 << 60
+    std::uint32_t inside, outside;
   };
-  // The complex, with smoothing only: every wall once, as the cube gives it (from its higher
-  // priority to its lower), over one vertex per grid edge, its surfel oriented from its voxel of
-  // higher priority; the walls of every label, selected or not, so that the smoothed points do
-  // not depend on the selection.
+  auto cubeOf = [&](const Wall& w) {
+    const std::uint64_t c = w.cubeAndEdges & ((std::uint64_t(1) << 52) - 1);
+    const std::uint64_t z = c / cxy, r = c - z * cxy, y = r / cx;
+    return Voxel{int(r - y * cx) - 1, int(y) - 1, int(z) - 1};
+  };
+  auto edgeOf = [](const Wall& w, int k) { return int(w.cubeAndEdges >> (52 + 4 * k) & 15u); };
+  const auto cubeSlabs = slabs(-1, dims.nz);
+  std::vector<std::vector<Wall>> slabWalls(cubeSlabs.size());
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), cubeSlabs.size(), [&](std::size_t k) {
+      std::unordered_map<std::uint32_t, CubeWalls> cache;  // by the corners' local ranks, 3 bits each
+      std::vector<Wall>& out = slabWalls[k];
+      for (int z = cubeSlabs[k].first; z < cubeSlabs[k].second; ++z) {
+        if (cancelled()) throw Cancelled("extraction cancelled");
+        for (int y = -1; y < dims.ny; ++y)
+          for (int x = -1; x < dims.nx; ++x) {
+            const Voxel m{x, y, z};
+            std::array<std::uint32_t, 8> p;
+            if (x >= 0 && y >= 0 && z >= 0 && x + 1 < dims.nx && y + 1 < dims.ny && z + 1 < dims.nz) {
+              const std::uint32_t* c = priority.get() + std::size_t(x) + nx * std::size_t(y) + nxy * std::size_t(z);
+              p = {c[0], c[1], c[nx], c[nx + 1], c[nxy], c[nxy + 1], c[nxy + nx], c[nxy + nx + 1]};
+            } else {
+              for (int i = 0; i < 8; ++i) p[std::size_t(i)] = priorityAt(m + cube::cornerOffset(i));
+            }
+            if (std::all_of(p.begin() + 1, p.end(), [&](std::uint32_t q) { return q == p[0]; })) continue;
+            std::array<std::uint32_t, 8> distinct = p;
+            std::sort(distinct.begin(), distinct.end());
+            const auto end = std::unique(distinct.begin(), distinct.end());
+            std::array<std::uint8_t, 8> local;
+            std::uint32_t key = 0;
+            for (int i = 0; i < 8; ++i) {
+              local[std::size_t(i)] = std::uint8_t(std::lower_bound(distinct.begin(), end, p[std::size_t(i)]) - distinct.begin());
+              key |= std::uint32_t(local[std::size_t(i)]) << (3 * i);
+            }
+            auto at = cache.find(key);
+            if (at == cache.end()) at = cache.emplace(key, cubeWalls(local, o.pair)).first;
+            const CubeWalls& walls = at->second;
+            const std::uint64_t cube = std::uint64_t(x + 1) + cx * std::uint64_t(y + 1) + cxy * std::uint64_t(z + 1);
+            for (int w = 0; w < walls.count; ++w) {
+              const WallTriangle& t = walls.triangles[std::size_t(w)];
+              if (out.size() == out.capacity()) reserveHugePages(out, std::max<std::size_t>(4096, 2 * out.capacity()));
+              out.push_back({cube | std::uint64_t(t.edges[0]) << 52 | std::uint64_t(t.edges[1]) << 56 |
+                                 std::uint64_t(t.edges[2]) << 60,
+                             distinct[t.inside], distinct[t.outside]});
+            }
+          }
+      }
+    });
+  });
+  std::vector<std::size_t> wallStart(cubeSlabs.size() + 1, 0);
+  for (std::size_t k = 0; k < cubeSlabs.size(); ++k) wallStart[k + 1] = wallStart[k] + slabWalls[k].size();
+  const std::size_t wallCount = wallStart.back();
+  if (wallCount > std::numeric_limits<std::uint32_t>::max())
+    throw std::length_error("shared walls: more than 2^32 - 1 wall triangles");
+  const FreshArray<Wall> walls = freshArray<Wall>(wallCount);
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), cubeSlabs.size(), [&](std::size_t k) {
+      std::copy(slabWalls[k].begin(), slabWalls[k].end(), walls.get() + wallStart[k]);
+      std::vector<Wall>().swap(slabWalls[k]);
+    });
+  });
+  // The grid edge of a wall's corner k, as the key of its surfel along +axis from its low voxel.
+  auto edgeKey = [&](const Voxel& m, int edge) {
+    return Surfel{m + cube::cornerOffset(cube::edgeLowCorner(edge)), directionOf(cube::edgeAxis(edge), +1)}.key();
+  };
+  // A new vertex's surfel, from the low voxel of its edge where fromLow(priority low, priority
+  // high) says so, else from its high voxel.
+  auto surfelOf = [&](const Voxel& m, int edge, auto&& fromLow) {
+    const Voxel lo = m + cube::cornerOffset(cube::edgeLowCorner(edge));
+    const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
+    const int axis = cube::edgeAxis(edge);
+    return fromLow(priorityAt(lo), priorityAt(hi)) ? Surfel{lo, directionOf(axis, +1)} : Surfel{hi, directionOf(axis, -1)};
+  };
+
+  // The complex, with smoothing or decimation: every wall once, as the cube gives it (from its
+  // higher priority to its lower), over one vertex per grid edge numbered at its first use, its
+  // surfel oriented from its voxel of higher priority; the walls of every label, selected or
+  // not, so that the smoothed points do not depend on the selection. Wall w is its triangle w.
   const bool smoothing = o.smooth.has_value(), decimating = o.decimate.has_value();
   const bool keepComplex = smoothing || decimating;
   struct Complex {
-    FlatKeyMap vertexOf;
     std::vector<Surfel> surfels;
     std::vector<std::array<std::uint32_t, 3>> triangles;
     std::vector<std::array<std::uint32_t, 2>> sides;  // each triangle's (inside, outside) priorities
   } complex;
-  // The vertex of cube m's edge in a vertex map keyed by grid edge, and whether it is new; a new
-  // one gets its surfel from its low voxel where fromLow(priority low, priority high) says so,
-  // else from its high voxel.
-  auto vertexOfEdge = [&](FlatKeyMap& vertexOf, std::vector<Surfel>& surfels,
-                          const Voxel& m, int edge, auto&& fromLow) {
-    const Voxel lo = m + cube::cornerOffset(cube::edgeLowCorner(edge));
-    const Voxel hi = m + cube::cornerOffset(cube::edgeHighCorner(edge));
-    const int axis = cube::edgeAxis(edge);
-    const auto [v, added] = vertexOf.tryEmplace(Surfel{lo, directionOf(axis, +1)}.key(), std::uint32_t(surfels.size()));
-    if (added)
-      surfels.push_back(fromLow(priorityAt(lo), priorityAt(hi)) ? Surfel{lo, directionOf(axis, +1)}
-                                                                : Surfel{hi, directionOf(axis, -1)});
-    return std::pair<std::uint32_t, bool>{v, added};
-  };
-  auto complexVertex = [&](const Voxel& m, int edge) {
-    return vertexOfEdge(complex.vertexOf, complex.surfels, m, edge,
-                        [](std::uint32_t pl, std::uint32_t ph) { return pl > ph; }).first;
-  };
-  std::vector<int> slot(labels.size() + 1, -1);  // priority -> index into building, -1 if not selected
-  std::vector<Building> building(selected.size());
-  for (std::size_t k = 0; k < selected.size(); ++k) slot[selected[k] + 1] = int(k);
-  std::unordered_map<std::uint32_t, CubeWalls> cache;  // by the corners' local ranks, 3 bits each
-  auto vertex = [&](Building& b, std::uint32_t label, const Voxel& m, int edge) {
-    // The label's own surfel has its voxel inside; a vertex of two other labels (a junction) is
-    // oriented from the one of higher priority.
-    const auto [v, added] = vertexOfEdge(b.vertexOf, b.surfels, m, edge, [&](std::uint32_t pl, std::uint32_t ph) {
-      return pl == label || (ph != label && pl > ph);
-    });
-    if (added && keepComplex) b.complexVertex.push_back(complexVertex(m, edge));
-    return v;
-  };
-  for (int z = -1; z < dims.nz; ++z)
-    for (int y = -1; y < dims.ny; ++y)
-      for (int x = -1; x < dims.nx; ++x) {
-        const Voxel m{x, y, z};
-        std::array<std::uint32_t, 8> p;
-        for (int i = 0; i < 8; ++i) p[std::size_t(i)] = priorityAt(m + cube::cornerOffset(i));
-        std::array<std::uint32_t, 8> distinct = p;
-        std::sort(distinct.begin(), distinct.end());
-        const auto end = std::unique(distinct.begin(), distinct.end());
-        if (end - distinct.begin() == 1) continue;
-        std::array<std::uint8_t, 8> local;
-        std::uint32_t key = 0;
-        for (int i = 0; i < 8; ++i) {
-          local[std::size_t(i)] = std::uint8_t(std::lower_bound(distinct.begin(), end, p[std::size_t(i)]) - distinct.begin());
-          key |= std::uint32_t(local[std::size_t(i)]) << (3 * i);
-        }
-        auto at = cache.find(key);
-        if (at == cache.end()) at = cache.emplace(key, cubeWalls(local, o.pair)).first;
-        const CubeWalls& walls = at->second;
-        for (int w = 0; w < walls.count; ++w) {
-          const WallTriangle& t = walls.triangles[std::size_t(w)];
-          if (keepComplex) {
-            complex.triangles.push_back(
-                {complexVertex(m, t.edges[0]), complexVertex(m, t.edges[1]), complexVertex(m, t.edges[2])});
-            complex.sides.push_back({distinct[t.inside], distinct[t.outside]});
-          }
-          for (const bool reversed : {false, true}) {
-            const std::uint32_t label = distinct[reversed ? t.outside : t.inside];
-            if (slot[label] < 0) continue;
-            Building& b = building[std::size_t(slot[label])];
-            std::array<std::uint32_t, 3> tri{vertex(b, label, m, t.edges[0]), vertex(b, label, m, t.edges[1]),
-                                             vertex(b, label, m, t.edges[2])};
-            if (reversed) std::swap(tri[1], tri[2]);
-            b.triangles.push_back(tri);
-            if (decimating) {
-              b.complexTriangle.push_back(std::uint32_t(complex.triangles.size() - 1));
-              b.reversed.push_back(char(reversed));
-            }
-          }
-        }
+  if (keepComplex) {
+    FlatKeyMap vertexOf;
+    complex.triangles.resize(wallCount);
+    complex.sides.resize(wallCount);
+    for (std::size_t w = 0; w < wallCount; ++w) {
+      const Voxel m = cubeOf(walls[w]);
+      for (int k = 0; k < 3; ++k) {
+        const int edge = edgeOf(walls[w], k);
+        const auto [v, added] = vertexOf.tryEmplace(edgeKey(m, edge), std::uint32_t(complex.surfels.size()));
+        if (added) complex.surfels.push_back(surfelOf(m, edge, [](std::uint32_t pl, std::uint32_t ph) { return pl > ph; }));
+        complex.triangles[w][std::size_t(k)] = v;
       }
+      complex.sides[w] = {walls[w].inside, walls[w].outside};
+    }
+  }
+
+  // Each selected label's walls, in order: its slot's range of wallsOf (count, prefix sum, fill).
+  std::vector<int> slot(labels.size() + 1, -1);  // priority -> index into the selection, -1 if not selected
+  for (std::size_t k = 0; k < selected.size(); ++k) slot[selected[k] + 1] = int(k);
+  std::vector<std::size_t> wallsStart(selected.size() + 1, 0);
+  for (std::size_t w = 0; w < wallCount; ++w)
+    for (const std::uint32_t side : {walls[w].inside, walls[w].outside})
+      if (slot[side] >= 0) ++wallsStart[std::size_t(slot[side]) + 1];
+  for (std::size_t k = 0; k < selected.size(); ++k) wallsStart[k + 1] += wallsStart[k];
+  const FreshArray<std::uint32_t> wallsOf = freshArray<std::uint32_t>(wallsStart.back());
+  {
+    std::vector<std::size_t> next(wallsStart.begin(), wallsStart.end() - 1);
+    for (std::size_t w = 0; w < wallCount; ++w)
+      for (const std::uint32_t side : {walls[w].inside, walls[w].outside})
+        if (slot[side] >= 0) wallsOf[next[std::size_t(slot[side])]++] = std::uint32_t(w);
+  }
 
   // 3. With smoothing, the complex smoothed from the midpoint mapping (then the geometry); with
   //    decimation, the complex decimated (after the smoothing).
@@ -194,6 +277,55 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     decimateWalls(smoothed, complex.triangles, complex.sides, removed, *o.decimate, o.cancel);
   }
 
+  // A label's mesh in grid edges: each of its walls in order, turned over where the label is
+  // its outside. The label's own surfel has its voxel inside; a vertex of two other labels (a
+  // junction) is oriented from the one of higher priority.
+  struct Building {
+    std::vector<Surfel> surfels;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<std::uint32_t> complexVertex;  // with smoothing or decimation: each vertex's in the complex
+    std::vector<std::uint32_t> complexTriangle;  // with decimation: each triangle's in the complex
+    std::vector<char> reversed;                  // ... and whether it is that one reversed
+  };
+  auto build = [&](std::size_t k) {
+    Building b;
+    const std::uint32_t label = std::uint32_t(selected[k] + 1);
+    FlatKeyMap vertexOf;
+    const std::size_t n = wallsStart[k + 1] - wallsStart[k];
+    vertexOf.reserve(n / 2 + 16);  // (a closed surface has about half as many vertices as triangles)
+    b.surfels.reserve(n / 2 + 16);
+    b.triangles.reserve(n);
+    std::uint64_t lastCube = ~std::uint64_t(0);
+    Voxel m{};
+    for (std::size_t i = wallsStart[k]; i < wallsStart[k + 1]; ++i) {
+      const std::uint32_t w = wallsOf[i];
+      if (const std::uint64_t cube = walls[w].cubeAndEdges & ((std::uint64_t(1) << 52) - 1); cube != lastCube) {
+        lastCube = cube;  // (a cube's walls are consecutive)
+        m = cubeOf(walls[w]);
+      }
+      std::array<std::uint32_t, 3> tri;
+      for (int c = 0; c < 3; ++c) {
+        const int edge = edgeOf(walls[w], c);
+        const auto [v, added] = vertexOf.tryEmplace(edgeKey(m, edge), std::uint32_t(b.surfels.size()));
+        if (added) {
+          b.surfels.push_back(surfelOf(m, edge, [&](std::uint32_t pl, std::uint32_t ph) {
+            return pl == label || (ph != label && pl > ph);
+          }));
+          if (keepComplex) b.complexVertex.push_back((decimating ? undecimated : complex.triangles)[w][std::size_t(c)]);
+        }
+        tri[std::size_t(c)] = v;
+      }
+      const bool reversed = walls[w].outside == label;
+      if (reversed) std::swap(tri[1], tri[2]);
+      b.triangles.push_back(tri);
+      if (decimating) {
+        b.complexTriangle.push_back(w);
+        b.reversed.push_back(char(reversed));
+      }
+    }
+    return b;
+  };
+
   // 4. Pinches split, vertices placed (midpoint mapping, then the geometry, or the smoothed
   //    complex's points), figures.
   //    The labels are independent here: in parallel on `threads`, largest first so that the
@@ -202,15 +334,13 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
   std::vector<std::size_t> order(selected.size());
   std::iota(order.begin(), order.end(), std::size_t(0));
   std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return building[a].triangles.size() > building[b].triangles.size(); });
-  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
+                   [&](std::size_t a, std::size_t b) { return wallsStart[a + 1] - wallsStart[a] > wallsStart[b + 1] - wallsStart[b]; });
   arena.execute([&] {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
   for (std::size_t at = range.begin(); at < range.end(); ++at) {
     const std::size_t k = order[at];
     if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
-    Building& b = building[k];
-    b.vertexOf.clear();  // done with it
+    Building b = build(k);
     std::vector<std::array<double, 3>> doubled(b.surfels.size());  // exact: 2 x the midpoint
     for (std::size_t v = 0; v < b.surfels.size(); ++v) {
       const Voxel c = b.surfels[v].inside(), d = b.surfels[v].outside();
