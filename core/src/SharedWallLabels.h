@@ -95,11 +95,14 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
   const std::vector<std::size_t> selected = select(labels);
   // Written once, in parallel: fresh memory on huge pages (lib/HugePages.h).
   const FreshArray<std::uint32_t> priority = freshArray<std::uint32_t>(voxelCount);
+  // Each slab counts its voxels per priority, unless a count array per slab would be large
+  // beside the volume (millions of labels on many threads): then one pass counts them after.
+  const bool countBySlab = (labels.size() + 1) * planeSlabs.size() <= voxelCount / 4;
   std::vector<std::vector<std::uint64_t>> slabVoxels(planeSlabs.size());
   arena.execute([&] {
     tbb::parallel_for(std::size_t(0), planeSlabs.size(), [&](std::size_t k) {
       std::vector<std::uint64_t>& count = slabVoxels[k];
-      count.assign(labels.size() + 1, 0);
+      count.assign(countBySlab ? labels.size() + 1 : 1, 0);
       T last = background;
       std::uint32_t p = 0;
       for (int z = planeSlabs[k].first; z < planeSlabs[k].second; ++z)
@@ -113,16 +116,19 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
                                   : std::uint32_t(std::lower_bound(labels.begin(), labels.end(), v) - labels.begin()) + 1;
             }
             row[x] = p;
-            ++count[p];
+            if (countBySlab) ++count[p];
           }
         }
     });
   });
   std::vector<std::uint64_t> voxels(labels.size() + 1, 0);
   for (auto& count : slabVoxels) {
-    for (std::size_t p = 0; p < count.size(); ++p) voxels[p] += count[p];
+    if (countBySlab)
+      for (std::size_t p = 0; p < count.size(); ++p) voxels[p] += count[p];
     std::vector<std::uint64_t>().swap(count);
   }
+  if (!countBySlab)
+    for (std::size_t i = 0; i < voxelCount; ++i) ++voxels[priority[i]];
   auto priorityAt = [&](const Voxel& v) -> std::uint32_t {
     if (!dims.contains(v)) return 0;
     return priority[std::size_t(v.x) + nx * std::size_t(v.y) + nxy * std::size_t(v.z)];
