@@ -5,7 +5,7 @@
 // as it is to the one inside and reversed to the one outside. A vertex is a grid edge between
 // two voxels of different labels (a surfel), numbered per label at its first use; where a label
 // touches itself at a vertex or an edge the pinch is split (converter/PinchSplit.h) and counted.
-// With LabelOptions::smooth the scan also keeps the complex itself (every wall once, over one
+// With LabelOptions::smooth the walls also make the complex itself (every wall once, over one
 // vertex per surfel), which is smoothed as a whole (ComplexSmoothing.h); each label's vertex
 // then takes its complex vertex's point, so a vertex has one point in every label. With
 // LabelOptions::decimate the complex (smoothed or not) is decimated wall by wall
@@ -272,13 +272,13 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     for (std::size_t v = 0; v < smoothed.size(); ++v) smoothed[v] = geometry.toPhysical(MidpointMapping{}(complex.surfels[v]));
   }
   if (smoothing) {
-    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+    if (cancelled()) throw Cancelled("extraction cancelled");
     complexReport = smoothComplex(smoothed, complex.surfels, complex.triangles, geometry, *o.smooth, o.cancel);
   }
   std::vector<std::array<std::uint32_t, 3>> undecimated;  // the complex's triangles before
   std::vector<char> removed;
   if (decimating) {
-    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+    if (cancelled()) throw Cancelled("extraction cancelled");
     undecimated = complex.triangles;
     decimateWalls(smoothed, complex.triangles, complex.sides, removed, *o.decimate, o.cancel);
   }
@@ -290,9 +290,9 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
     std::vector<Surfel> surfels;
     std::vector<std::array<std::uint32_t, 3>> triangles;
     std::vector<std::uint32_t> complexVertex;  // with smoothing or decimation: each vertex's in the complex
-    std::vector<std::uint32_t> complexTriangle;  // with decimation: each triangle's in the complex
-    std::vector<char> reversed;                  // ... and whether it is that one reversed
   };
+  // (Triangle i of label k is wall wallsOf[wallsStart[k] + i], the complex's triangle of that
+  // index, reversed where the label is its outside.)
   auto build = [&](std::size_t k) {
     Building b;
     const std::uint32_t label = std::uint32_t(selected[k] + 1);
@@ -321,13 +321,8 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
         }
         tri[std::size_t(c)] = v;
       }
-      const bool reversed = walls[w].outside == label;
-      if (reversed) std::swap(tri[1], tri[2]);
+      if (walls[w].outside == label) std::swap(tri[1], tri[2]);
       b.triangles.push_back(tri);
-      if (decimating) {
-        b.complexTriangle.push_back(w);
-        b.reversed.push_back(char(reversed));
-      }
     }
     return b;
   };
@@ -345,7 +340,7 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
   for (std::size_t at = range.begin(); at < range.end(); ++at) {
     const std::size_t k = order[at];
-    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Cancelled("extraction cancelled");
+    if (cancelled()) throw Cancelled("extraction cancelled");
     Building b = build(k);
     std::vector<std::array<double, 3>> doubled(b.surfels.size());  // exact: 2 x the midpoint
     for (std::size_t v = 0; v < b.surfels.size(); ++v) {
@@ -396,24 +391,25 @@ std::vector<LabelSurface> sharedWallSurfaces(const VolumeRef<T>& image, const Vo
       std::vector<std::array<std::uint32_t, 3>> kept;
       kept.reserve(s.triangles.size());
       for (std::size_t i = 0; i < s.triangles.size(); ++i) {
-        const std::uint32_t c = b.complexTriangle[i];
+        const std::uint32_t c = wallsOf[wallsStart[k] + i];
         if (removed[c]) continue;
+        const bool reversed = walls[c].outside == std::uint32_t(selected[k] + 1);
         const auto& was = undecimated[c];
         const auto& now = complex.triangles[c];
         std::array<std::uint32_t, 3> t;
-        for (int k = 0; k < 3; ++k) {
-          const auto at = std::find(was.begin(), was.end(), now[std::size_t(k)]);
+        for (std::size_t corner = 0; corner < 3; ++corner) {
+          const auto at = std::find(was.begin(), was.end(), now[corner]);
           if (at != was.end()) {
             int j = int(at - was.begin());
-            if (b.reversed[i] && j) j = 3 - j;  // (the label's triangle is the complex's with corners 1, 2 swapped)
-            t[std::size_t(k)] = s.triangles[i][std::size_t(j)];
+            if (reversed && j) j = 3 - j;  // (the label's triangle is the complex's with corners 1, 2 swapped)
+            t[corner] = s.triangles[i][std::size_t(j)];
           } else {
-            const auto v = vertexOfComplex.find(now[std::size_t(k)]);
+            const auto v = vertexOfComplex.find(now[corner]);
             if (v == vertexOfComplex.end()) throw InternalError("shared walls: a decimated wall's vertex is not its label's");
-            t[std::size_t(k)] = v->second;
+            t[corner] = v->second;
           }
         }
-        if (b.reversed[i]) std::swap(t[1], t[2]);
+        if (reversed) std::swap(t[1], t[2]);
         kept.push_back(t);
       }
       // The vertices removed dropped, the others renumbered in order.
